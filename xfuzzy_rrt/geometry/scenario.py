@@ -1,0 +1,305 @@
+"""The scenario model (arm, start, goal, obstacles) and its validated TOML loader.
+
+A scenario is read once into frozen dataclasses; every later layer trusts it. So the loader is
+strict about what matters (types, signs, dimensions, that start and goal are reachable
+configurations) and names the file and key at fault in one line. Unknown keys are *not* fatal
+(generated files may carry extra metadata) but are recorded in ``Scenario.unknown_keys`` so the
+CLI can warn about likely typos.
+
+The format is described in ``shared/scenarios/FORMAT.md``: metres for lengths, degrees for joint
+angles, circles and axis-aligned boxes as obstacles, N links.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from xfuzzy_rrt.errors import ScenarioError
+
+CIRCLE = 0
+BOX = 1
+
+
+@dataclass(frozen=True)
+class Circle:
+    center: tuple[float, float]
+    radius: float
+
+
+@dataclass(frozen=True)
+class Box:
+    min: tuple[float, float]
+    max: tuple[float, float]
+
+
+Obstacle = Circle | Box
+
+
+@dataclass(frozen=True)
+class Arm:
+    """A planar serial arm: link *i* turns about the tip of link *i-1* (joint 1 about ``base``)."""
+
+    links: tuple[float, ...]
+    base: tuple[float, float] = (0.0, 0.0)
+    link_radius: float = 0.0
+    joint_limits_deg: tuple[tuple[float, float], ...] = ()
+
+    @property
+    def dof(self) -> int:
+        return len(self.links)
+
+    @property
+    def reach(self) -> float:
+        return float(sum(self.links))
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    arm: Arm
+    start_deg: tuple[float, ...]
+    goal_deg: tuple[float, ...]
+    obstacles: tuple[Obstacle, ...] = ()
+    description: str = ""
+    source: str = ""
+    unknown_keys: tuple[str, ...] = field(default=(), compare=False)
+
+    def arrays(self) -> "ScenarioArrays":
+        """The flat arrays compiled code works on (see :class:`ScenarioArrays`)."""
+        return ScenarioArrays.from_scenario(self)
+
+
+@dataclass(frozen=True)
+class ScenarioArrays:
+    """A scenario as contiguous float64 arrays for numba kernels.
+
+    ``obstacles`` rows are ``[kind, a, b, c, d]``: circles ``[0, cx, cy, r, 0]``, boxes
+    ``[1, xmin, ymin, xmax, ymax]``. ``limits_deg`` is ``[dof, 2]``.
+    """
+
+    links: np.ndarray
+    base: np.ndarray
+    link_radius: float
+    obstacles: np.ndarray
+    limits_deg: np.ndarray
+    start_deg: np.ndarray
+    goal_deg: np.ndarray
+
+    @classmethod
+    def from_scenario(cls, s: Scenario) -> "ScenarioArrays":
+        obs = np.zeros((len(s.obstacles), 5), dtype=np.float64)
+        for i, o in enumerate(s.obstacles):
+            if isinstance(o, Circle):
+                obs[i] = (CIRCLE, o.center[0], o.center[1], o.radius, 0.0)
+            else:
+                obs[i] = (BOX, o.min[0], o.min[1], o.max[0], o.max[1])
+        return cls(
+            links=np.asarray(s.arm.links, dtype=np.float64),
+            base=np.asarray(s.arm.base, dtype=np.float64),
+            link_radius=float(s.arm.link_radius),
+            obstacles=obs,
+            limits_deg=np.asarray(s.arm.joint_limits_deg, dtype=np.float64).reshape(-1, 2),
+            start_deg=np.asarray(s.start_deg, dtype=np.float64),
+            goal_deg=np.asarray(s.goal_deg, dtype=np.float64),
+        )
+
+
+# --------------------------------------------------------------------------------------------
+# Loading and validation
+# --------------------------------------------------------------------------------------------
+
+_TOP_KEYS = {"name", "description", "arm", "start", "goal", "obstacles"}
+_ARM_KEYS = {"links", "base", "link_radius", "joint_limits_deg"}
+_CIRCLE_KEYS = {"type", "center", "radius"}
+_BOX_KEYS = {"type", "min", "max"}
+
+
+class _Reader:
+    """Typed accessors that raise :class:`ScenarioError` naming the key."""
+
+    def __init__(self, file: str) -> None:
+        self.file = file
+
+    def fail(self, key: str, message: str) -> ScenarioError:
+        return ScenarioError(self.file, key, message)
+
+    def table(self, data: dict[str, Any], key: str, path: str, required: bool = True) -> dict | None:
+        if key not in data:
+            if required:
+                raise self.fail(path, "missing required table")
+            return None
+        value = data[key]
+        if not isinstance(value, dict):
+            raise self.fail(path, f"must be a table, got {_typename(value)}")
+        return value
+
+    def number(self, value: Any, path: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(path, f"must be a number, got {_typename(value)}")
+        x = float(value)
+        if not math.isfinite(x):
+            raise self.fail(path, f"must be finite, got {value}")
+        return x
+
+    def numbers(self, value: Any, path: str, length: int | None = None) -> tuple[float, ...]:
+        if not isinstance(value, list):
+            raise self.fail(path, f"must be an array of numbers, got {_typename(value)}")
+        if length is not None and len(value) != length:
+            raise self.fail(path, f"must have {length} numbers, got {len(value)}")
+        return tuple(self.number(v, f"{path}[{i}]") for i, v in enumerate(value))
+
+    def required(self, data: dict[str, Any], key: str, path: str) -> Any:
+        if key not in data:
+            raise self.fail(path, "missing required key")
+        return data[key]
+
+
+def _typename(value: Any) -> str:
+    return {
+        bool: "a boolean", int: "an integer", float: "a float", str: "a string",
+        list: "an array", dict: "a table",
+    }.get(type(value), type(value).__name__)
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario TOML file. Raises :class:`ScenarioError` on any problem."""
+    path = Path(path)
+    file = str(path)
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        raise ScenarioError(file, "", "no such file") from None
+    except IsADirectoryError:
+        raise ScenarioError(file, "", "is a directory, expected a scenario .toml file") from None
+    except OSError as exc:
+        raise ScenarioError(file, "", f"cannot read: {exc.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(file, "", f"not valid UTF-8 (byte {exc.start})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        message = str(exc)
+        m = re.search(r"\(at line (\d+), column (\d+)\)", message)
+        if m:
+            detail = message[: m.start()].strip()
+            raise ScenarioError(f"{file}:{m.group(1)}", "", f"TOML syntax error: {detail} "
+                                f"(column {m.group(2)})") from None
+        raise ScenarioError(file, "", f"TOML syntax error: {message}") from None
+    return scenario_from_dict(data, file)
+
+
+def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenario:
+    """Validate an already-parsed scenario mapping (the loader's second half)."""
+    r = _Reader(file)
+    unknown: list[str] = [k for k in data if k not in _TOP_KEYS]
+
+    name = r.required(data, "name", "name")
+    if not isinstance(name, str) or not name.strip():
+        raise r.fail("name", "must be a non-empty string")
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise r.fail("description", f"must be a string, got {_typename(description)}")
+
+    arm_t = r.table(data, "arm", "arm")
+    unknown += [f"arm.{k}" for k in arm_t if k not in _ARM_KEYS]
+    links_raw = r.required(arm_t, "links", "arm.links")
+    links = r.numbers(links_raw, "arm.links")
+    if not links:
+        raise r.fail("arm.links", "must list at least one link length")
+    for i, length in enumerate(links):
+        if length <= 0:
+            raise r.fail(f"arm.links[{i}]", f"link length must be > 0, got {length:g}")
+    base = r.numbers(arm_t.get("base", [0.0, 0.0]), "arm.base", length=2)
+    link_radius = r.number(arm_t.get("link_radius", 0.0), "arm.link_radius")
+    if link_radius < 0:
+        raise r.fail("arm.link_radius", f"must be >= 0, got {link_radius:g}")
+    dof = len(links)
+    limits_raw = arm_t.get("joint_limits_deg", [[-180.0, 180.0]] * dof)
+    if not isinstance(limits_raw, list):
+        raise r.fail("arm.joint_limits_deg", f"must be an array of [min, max] pairs, got "
+                     f"{_typename(limits_raw)}")
+    if len(limits_raw) != dof:
+        raise r.fail("arm.joint_limits_deg", f"must have one [min, max] pair per link ({dof}), "
+                     f"got {len(limits_raw)}")
+    limits = []
+    for i, pair in enumerate(limits_raw):
+        lo, hi = r.numbers(pair, f"arm.joint_limits_deg[{i}]", length=2)
+        if not lo < hi:
+            raise r.fail(f"arm.joint_limits_deg[{i}]", f"min must be < max, got [{lo:g}, {hi:g}]")
+        if lo < -180.0 or hi > 180.0:
+            raise r.fail(f"arm.joint_limits_deg[{i}]",
+                         f"must lie within [-180, 180] (no wrap-around), got [{lo:g}, {hi:g}]")
+        limits.append((lo, hi))
+    arm = Arm(links=links, base=(base[0], base[1]), link_radius=link_radius,
+              joint_limits_deg=tuple(limits))
+
+    configs = {}
+    for which in ("start", "goal"):
+        t = r.table(data, which, which)
+        unknown += [f"{which}.{k}" for k in t if k != "q_deg"]
+        q_raw = r.required(t, "q_deg", f"{which}.q_deg")
+        if isinstance(q_raw, list) and len(q_raw) != dof:
+            raise r.fail(f"{which}.q_deg", f"must have one angle per link ({dof}), got {len(q_raw)}")
+        configs[which] = r.numbers(q_raw, f"{which}.q_deg", length=dof)
+
+    obstacles: list[Obstacle] = []
+    obs_raw = data.get("obstacles", [])
+    if not isinstance(obs_raw, list):
+        raise r.fail("obstacles", f"must be an array of tables ([[obstacles]]), got "
+                     f"{_typename(obs_raw)}")
+    for i, o in enumerate(obs_raw):
+        key = f"obstacles[{i}]"
+        if not isinstance(o, dict):
+            raise r.fail(key, f"must be a table, got {_typename(o)}")
+        kind = r.required(o, "type", f"{key}.type")
+        if kind == "circle":
+            unknown += [f"{key}.{k}" for k in o if k not in _CIRCLE_KEYS]
+            center = r.numbers(r.required(o, "center", f"{key}.center"), f"{key}.center", 2)
+            radius = r.number(r.required(o, "radius", f"{key}.radius"), f"{key}.radius")
+            if radius <= 0:
+                raise r.fail(f"{key}.radius", f"must be > 0, got {radius:g}")
+            obstacles.append(Circle(center=(center[0], center[1]), radius=radius))
+        elif kind == "box":
+            unknown += [f"{key}.{k}" for k in o if k not in _BOX_KEYS]
+            lo = r.numbers(r.required(o, "min", f"{key}.min"), f"{key}.min", 2)
+            hi = r.numbers(r.required(o, "max", f"{key}.max"), f"{key}.max", 2)
+            for axis, name_ in ((0, "x"), (1, "y")):
+                if not hi[axis] > lo[axis]:
+                    raise r.fail(f"{key}.max", f"must exceed min on the {name_} axis, got "
+                                 f"max {hi[axis]:g} <= min {lo[axis]:g}")
+            obstacles.append(Box(min=(lo[0], lo[1]), max=(hi[0], hi[1])))
+        else:
+            raise r.fail(f"{key}.type", f"unknown obstacle type {kind!r} (expected 'circle' or 'box')")
+
+    scenario = Scenario(
+        name=name.strip(), arm=arm, start_deg=configs["start"], goal_deg=configs["goal"],
+        obstacles=tuple(obstacles), description=description, source=file,
+        unknown_keys=tuple(unknown),
+    )
+    _check_endpoints(scenario, r)
+    return scenario
+
+
+def _check_endpoints(s: Scenario, r: _Reader) -> None:
+    """Start and goal must be within the joint limits and collision-free (touching counts)."""
+    from xfuzzy_rrt.geometry.collision import clearance
+
+    arrays = s.arrays()
+    for which, q in (("start", s.start_deg), ("goal", s.goal_deg)):
+        for j, (angle, (lo, hi)) in enumerate(zip(q, s.arm.joint_limits_deg)):
+            if not lo <= angle <= hi:
+                raise r.fail(f"{which}.q_deg[{j}]",
+                             f"{angle:g} deg is outside the joint limits [{lo:g}, {hi:g}]")
+        c = clearance(arrays, np.asarray(q, dtype=np.float64))
+        if c <= 0.0:
+            raise r.fail(f"{which}.q_deg", f"configuration {list(q)} is in collision "
+                         f"(an arm link touches or overlaps an obstacle)")

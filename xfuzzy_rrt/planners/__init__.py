@@ -1,0 +1,1 @@
+"""Sampling-based planners (RRT baseline, Fuzzy-RRT) and what they share: RNG, tree, results."""

@@ -1,0 +1,10 @@
+"""Fuzzy inference for Fuzzy-RRT: rulebook model, text format, FLL interop, compiled TSK engine.
+
+This package knows nothing of geometry or planners. The planner sees only the compiled arrays
+(``knots`` float64[6, 4, 5] and ``consts`` float64[6, 625]) produced by
+:meth:`xfuzzy_rrt.fuzzy.rulebook.Rulebook.arrays` and evaluated by
+:func:`xfuzzy_rrt.fuzzy.engine.infer`.
+
+Submodules are imported lazily by their users: importing :mod:`xfuzzy_rrt.fuzzy` does not pull
+in numba (only :mod:`xfuzzy_rrt.fuzzy.engine` does).
+"""

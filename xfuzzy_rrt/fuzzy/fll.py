@@ -1,0 +1,405 @@
+"""Export to and import from fuzzylite's FLL format (one ``Engine`` per output FIS).
+
+Why: FLL is the lingua franca of fuzzylite/pyfuzzylite/QtFuzzyLite, so a rulebook can be
+checked, plotted or reused with an outside tool, and an outside tool can supply a rulebook.
+The export follows the "FLL interop notes" in SPEC.md, which record what pyfuzzylite 8
+actually computes:
+
+- four ``InputVariable`` with ``lock-range: true`` (pyfuzzylite then clamps inputs to the
+  range, as our engine does); terms: the left shoulder as ``Ramp p1 lo``, the triangles as
+  ``Triangle a b c``, the right shoulder as ``Ramp p3 hi``;
+- one ``OutputVariable`` with ``aggregation: none`` and ``defuzzifier: WeightedAverage
+  TakagiSugeno`` and one ``Constant`` term ``rN`` per rule (pyfuzzylite merges rules that
+  share a term under ``Maximum``/``AlgebraicSum`` aggregation, which would be wrong);
+- a ``RuleBlock`` with ``conjunction: AlgebraicProduct``, ``activation: General``;
+- every number with 17 significant digits (``%.17g``): exact for float64, whereas
+  pyfuzzylite's own default of 3 decimals moves outputs by ~3e-3.
+
+The ``Engine``'s ``description`` line carries the rulebook name, bounds mode and sha256 so an
+import can restore them. :func:`import_fll` reads this subset back (terms may come in any
+order and shoulders may also be ``Triangle -inf lo p1`` / ``Triangle p3 hi inf``), checks that
+the terms form the Ruspini partition the engine assumes, and reports every problem with file
+and line. Export followed by import gives identical arrays.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import math
+import os
+import re
+from pathlib import Path
+
+from xfuzzy_rrt.errors import RulebookError
+from xfuzzy_rrt.fuzzy.rulebook import Rulebook, write_files
+from xfuzzy_rrt.fuzzy.system import FuzzySystem, InputPartition, peaks_problem, term_name_problem
+from xfuzzy_rrt.fuzzy.variables import (
+    INPUT_RANGES,
+    INPUTS,
+    N_RULES,
+    N_TERMS,
+    OUTPUT_RANGES,
+    OUTPUTS,
+    rule_index,
+    rule_terms,
+)
+
+FLL_SUFFIX = ".fll"
+_DESCRIPTION_TAG = "xfuzzy-rrt"
+
+Problem = tuple[str, "int | None", str]
+
+
+def num(v: float) -> str:
+    """17 significant digits: exact for any float64 and read back bit-identically."""
+    return f"{float(v):.17g}"
+
+
+def fll_file_name(output: str) -> str:
+    return output + FLL_SUFFIX
+
+
+# ---------------------------------------------------------------------------- export
+
+
+def format_fll(fis: FuzzySystem, rulebook: Rulebook | None = None) -> str:
+    """FLL text of one FIS (an ``Engine`` named after its output)."""
+    lines = [f"# xfuzzy-rrt export of FIS {fis.output} (pyfuzzylite 8 compatible)"]
+    lines.append(f"Engine: {fis.output}")
+    if rulebook is not None:
+        meta = {"name": rulebook.name, "bounds_mode": rulebook.bounds_mode, "sha256": rulebook.sha256}
+        lines.append(f"  description: {_DESCRIPTION_TAG} {json.dumps(meta, sort_keys=True)}")
+    for inp in fis.inputs:
+        lo, p1, p2, p3, hi = inp.peaks
+        t = inp.terms
+        lines += [
+            f"InputVariable: {inp.name}",
+            "  enabled: true",
+            f"  range: {num(lo)} {num(hi)}",
+            "  lock-range: true",
+            f"  term: {t[0]} Ramp {num(p1)} {num(lo)}",
+            f"  term: {t[1]} Triangle {num(lo)} {num(p1)} {num(p2)}",
+            f"  term: {t[2]} Triangle {num(p1)} {num(p2)} {num(p3)}",
+            f"  term: {t[3]} Triangle {num(p2)} {num(p3)} {num(hi)}",
+            f"  term: {t[4]} Ramp {num(p3)} {num(hi)}",
+        ]
+    lo, hi = fis.range
+    lines += [
+        f"OutputVariable: {fis.output}",
+        "  enabled: true",
+        f"  range: {num(lo)} {num(hi)}",
+        "  lock-range: false",
+        "  aggregation: none",
+        "  defuzzifier: WeightedAverage TakagiSugeno",
+        "  default: nan",
+        "  lock-previous: false",
+    ]
+    lines += [f"  term: r{r} Constant {num(c)}" for r, c in enumerate(fis.consts)]
+    lines += [
+        "RuleBlock: rules",
+        "  enabled: true",
+        "  conjunction: AlgebraicProduct",
+        "  disjunction: none",
+        "  implication: none",
+        "  activation: General",
+    ]
+    for r in range(N_RULES):
+        t = rule_terms(r)
+        ante = " and ".join(f"{inp.name} is {inp.terms[t[i]]}" for i, inp in enumerate(fis.inputs))
+        lines.append(f"  rule: if {ante} then {fis.output} is r{r}")
+    return "\n".join(lines) + "\n"
+
+
+def export_fll(rulebook: Rulebook, out_dir: str | os.PathLike[str]) -> list[Path]:
+    """Write ``<output>.fll`` for each of the six FIS into *out_dir*; return the paths."""
+    texts = {fll_file_name(s.output): format_fll(s, rulebook) for s in rulebook.systems}
+    root = write_files(out_dir, texts)
+    return [root / name for name in texts]
+
+
+# ---------------------------------------------------------------------------- import
+
+
+class _Var:
+    def __init__(self, kind: str, name: str, line: int) -> None:
+        self.kind, self.name, self.line = kind, name, line
+        self.props: dict[str, tuple[int, str]] = {}
+        self.terms: list[tuple[int, str, str, list[str]]] = []  # (line, name, type, params)
+
+
+def _float(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def _peak_of(ttype: str, params: list[float]) -> tuple[float, float, float] | None:
+    """``(left foot, peak, right foot)`` of a supported term, ``None`` if unsupported."""
+    if ttype == "Triangle" and len(params) == 3:
+        return params[0], params[1], params[2]
+    if ttype == "Ramp" and len(params) == 2:
+        start, end = params
+        if start > end:  # falling: 1 at end (left shoulder)
+            return -math.inf, end, start
+        if start < end:  # rising: 1 at end (right shoulder)
+            return start, end, math.inf
+    return None
+
+
+def parse_fll(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem | None, dict, list[Problem]]:
+    """Parse one exported-style FLL engine into a FIS. Returns (fis or None, meta, problems)."""
+    problems: list[Problem] = []
+
+    def problem(line: int | None, msg: str) -> None:
+        problems.append((file, line, msg))
+
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        return None, {}, [(file, data[: exc.start].count(b"\n") + 1, "not valid UTF-8")]
+    meta: dict = {}
+    engine_name: tuple[int, str] | None = None
+    variables: list[_Var] = []
+    block: dict[str, tuple[int, str]] = {}
+    rules: list[tuple[int, str]] = []
+    section = None
+    for n, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        key, sep, value = line.partition(":")
+        key, value = key.strip(), value.strip()
+        if not sep:
+            problem(n, f"expected 'key: value', got {line[:60]!r}")
+            continue
+        if key == "Engine":
+            engine_name = (n, value)
+            section = "Engine"
+        elif key in ("InputVariable", "OutputVariable"):
+            variables.append(_Var(key, value, n))
+            section = "var"
+        elif key == "RuleBlock":
+            section = "RuleBlock"
+        elif section == "Engine" and key == "description":
+            if value.startswith(_DESCRIPTION_TAG + " "):
+                try:
+                    meta = json.loads(value[len(_DESCRIPTION_TAG) + 1:])
+                except json.JSONDecodeError:
+                    meta = {}
+        elif section == "var" and key == "term":
+            parts = value.split()
+            if len(parts) < 2:
+                problem(n, "expected 'term: NAME TYPE PARAMETERS...'")
+                continue
+            variables[-1].terms.append((n, parts[0], parts[1], parts[2:]))
+        elif section == "var":
+            variables[-1].props[key] = (n, value)
+        elif section == "RuleBlock" and key == "rule":
+            rules.append((n, value))
+        elif section == "RuleBlock":
+            block[key] = (n, value)
+        elif section is None:
+            problem(n, f"{key!r} before any 'Engine:' section")
+    if engine_name is None:
+        problem(1, "no 'Engine:' section")
+
+    inputs = {v.name: v for v in variables if v.kind == "InputVariable"}
+    outputs = [v for v in variables if v.kind == "OutputVariable"]
+    for v in variables:
+        if v.kind == "InputVariable" and v.name not in INPUTS:
+            problem(v.line, f"unknown input variable {v.name!r} (inputs: {', '.join(INPUTS)})")
+    for name in INPUTS:
+        if name not in inputs:
+            problem(engine_name[0] if engine_name else 1, f"missing InputVariable {name!r}")
+    if len(outputs) != 1:
+        problem(engine_name[0] if engine_name else 1, f"expected one OutputVariable, found {len(outputs)}")
+    elif outputs[0].name != expected_output:
+        problem(outputs[0].line, f"wrong output variable {outputs[0].name!r}: this file describes {expected_output!r}")
+
+    # engine semantics we can represent
+    for key, allowed in (("conjunction", {"AlgebraicProduct"}), ("activation", {"General"})):
+        if key in block and block[key][1] not in allowed:
+            problem(block[key][0], f"{key} {block[key][1]!r} is not supported (xfuzzy-rrt uses {', '.join(sorted(allowed))})")
+    if outputs:
+        out = outputs[0]
+        agg = out.props.get("aggregation")
+        if agg and agg[1] != "none":
+            problem(agg[0], f"aggregation {agg[1]!r} is not supported (needs 'none'; merged rules would change the result)")
+        dfz = out.props.get("defuzzifier")
+        if dfz and dfz[1].split()[0] != "WeightedAverage":
+            problem(dfz[0], f"defuzzifier {dfz[1]!r} is not supported (needs WeightedAverage)")
+
+    def check_range(v: _Var, expected: tuple[float, float]) -> None:
+        rng = v.props.get("range")
+        if rng is None:
+            problem(v.line, f"{v.name}: missing range")
+            return
+        vals = [_float(x) for x in rng[1].split()]
+        if len(vals) != 2 or tuple(vals) != expected:
+            problem(rng[0], f"range of {v.name} must be {num(expected[0])} {num(expected[1])}, got {rng[1]}")
+
+    partitions: dict[str, InputPartition] = {}
+    for name in INPUTS:
+        v = inputs.get(name)
+        if v is None:
+            continue
+        check_range(v, INPUT_RANGES[name])
+        part = _partition(v, problem)
+        if part is not None:
+            partitions[name] = part
+
+    consts: list[float | None] = [None] * N_RULES
+    if outputs and outputs[0].name == expected_output:
+        out = outputs[0]
+        check_range(out, OUTPUT_RANGES[expected_output])
+        values: dict[str, float] = {}
+        for n, tname, ttype, params in out.terms:
+            value = _float(params[0]) if ttype == "Constant" and len(params) == 1 else None
+            if value is None or not math.isfinite(value):
+                problem(n, f"output term {tname!r} must be 'Constant VALUE' with a finite value")
+                continue
+            lo, hi = OUTPUT_RANGES[expected_output]
+            if not lo <= value <= hi:
+                problem(n, f"constant {params[0]} outside the output range [{lo!r}, {hi!r}]")
+                continue
+            values[tname] = value
+        if len(partitions) == len(INPUTS):
+            seen: dict[int, int] = {}
+            rule_re = re.compile(r"if\s+(.+?)\s+then\s+(\S+)\s+is\s+(\S+)(?:\s+with\s+(\S+))?\Z")
+            for n, rtext in rules:
+                m = rule_re.match(" ".join(rtext.split()))
+                if not m:
+                    problem(n, "malformed rule (expected 'if A is T and ... then OUT is TERM')")
+                    continue
+                if m.group(4) is not None and _float(m.group(4)) != 1.0:
+                    problem(n, "rule weights other than 1 are not supported")
+                    continue
+                by_var = {}
+                ok = True
+                for clause in re.split(r"\s+and\s+", m.group(1)):
+                    cm = re.fullmatch(r"(\S+)\s+is\s+(\S+)", clause)
+                    if not cm or cm.group(1) not in partitions or cm.group(1) in by_var:
+                        problem(n, f"unsupported condition {clause!r} (need each input once: 'INPUT is TERM')")
+                        ok = False
+                        break
+                    terms = partitions[cm.group(1)].terms
+                    if cm.group(2) not in terms:
+                        problem(n, f"unknown term {cm.group(2)!r} for {cm.group(1)}")
+                        ok = False
+                        break
+                    by_var[cm.group(1)] = terms.index(cm.group(2))
+                if not ok:
+                    continue
+                if len(by_var) != len(INPUTS):
+                    problem(n, "every rule must name all four inputs")
+                    continue
+                if m.group(2) != expected_output or m.group(3) not in values:
+                    problem(n, f"consequent '{m.group(2)} is {m.group(3)}' is not a Constant term of {expected_output}")
+                    continue
+                r = rule_index([by_var[name] for name in INPUTS])
+                if r in seen:
+                    problem(n, f"duplicate rule: same conditions as line {seen[r]}")
+                    continue
+                seen[r] = n
+                consts[r] = values[m.group(3)]
+            missing = [r for r in range(N_RULES) if consts[r] is None]
+            if missing:
+                problem(None, f"{len(missing)} of {N_RULES} rules missing (first: r{missing[0]})")
+    if problems:
+        return None, meta, problems
+    fis = FuzzySystem(
+        output=expected_output,
+        inputs=tuple(partitions[name] for name in INPUTS),
+        consts=tuple(consts),
+    )
+    return fis, meta, []
+
+
+def _partition(v: _Var, problem) -> InputPartition | None:
+    """The five terms of an input as a Ruspini partition, or ``None`` (problems reported)."""
+    if len(v.terms) != N_TERMS:
+        problem(v.line, f"{v.name}: expected {N_TERMS} terms, got {len(v.terms)}")
+        return None
+    shapes = []
+    for n, tname, ttype, params in v.terms:
+        vals = [_float(p) for p in params]
+        shape = None if any(x is None for x in vals) else _peak_of(ttype, vals)
+        bad_name = term_name_problem(tname)
+        if bad_name:
+            problem(n, bad_name)
+            return None
+        if shape is None:
+            problem(n, f"term {tname!r}: only Triangle and Ramp terms are supported, got {ttype} {' '.join(params)}")
+            return None
+        shapes.append((shape[1], shape, tname, n))
+    shapes.sort(key=lambda s: s[0])
+    lo, hi = INPUT_RANGES[v.name]
+    peaks = [s[0] for s in shapes]
+    # infinite shoulders: -inf / +inf feet are fine at the ends
+    problem_text = peaks_problem(tuple(peaks), lo, hi)
+    if problem_text:
+        problem(v.line, f"{v.name}: {problem_text}")
+        return None
+    for j, (peak, (left, _, right), tname, n) in enumerate(shapes):
+        want_left = peaks[j - 1] if j > 0 else None
+        want_right = peaks[j + 1] if j < N_TERMS - 1 else None
+        ok_left = left == want_left if want_left is not None else (left == -math.inf or left == peak)
+        ok_right = right == want_right if want_right is not None else (right == math.inf or right == peak)
+        if not (ok_left and ok_right):
+            problem(n, f"term {tname!r} does not fit a Ruspini partition (feet must be the neighbouring peaks)")
+            return None
+    return InputPartition(name=v.name, terms=tuple(s[2] for s in shapes), peaks=tuple(peaks))
+
+
+def import_fll(
+    fll_dir: str | os.PathLike[str],
+    *,
+    name: str | None = None,
+    bounds_mode: str | None = None,
+    command: str | None = None,
+) -> Rulebook:
+    """Read ``<output>.fll`` for all six outputs from *fll_dir* into a :class:`Rulebook`.
+
+    Name and bounds mode come from the export's description line unless given; otherwise the
+    directory name and ``"absolute"`` (the paper's reading). Raises :class:`RulebookError` with
+    every problem found.
+    """
+    root = Path(fll_dir)
+    if not root.is_dir():
+        raise RulebookError([(str(root), None, "FLL directory does not exist or is not a directory")])
+    problems: list[Problem] = []
+    systems = []
+    meta: dict = {}
+    for output in OUTPUTS:
+        file = root / fll_file_name(output)
+        try:
+            data = file.read_bytes()
+        except OSError as exc:
+            problems.append((str(file), None, "missing file" if isinstance(exc, FileNotFoundError) else f"cannot read: {exc}"))
+            continue
+        fis, file_meta, found = parse_fll(data, str(file), output)
+        problems.extend(found)
+        systems.append(fis)
+        meta = meta or file_meta
+    if problems:
+        raise RulebookError(problems)
+    mode = bounds_mode or meta.get("bounds_mode") or "absolute"
+    if mode not in ("absolute", "relative"):
+        raise RulebookError([(str(root), None, f"bounds mode must be absolute or relative, got {mode!r}")])
+    provenance = {
+        "kind": "imported-fll",
+        "source": str(root),
+        "date": dt.datetime.now(dt.timezone.utc).replace(microsecond=0).isoformat(),
+    }
+    if command:
+        provenance["command"] = command
+    if meta.get("sha256"):
+        provenance["source_sha256"] = str(meta["sha256"])
+    return Rulebook(
+        name=name or str(meta.get("name") or root.resolve().name),
+        bounds_mode=mode,
+        systems=tuple(systems),
+        provenance=provenance,
+    )

@@ -1,0 +1,328 @@
+"""A rulebook: the frozen model of six FIS plus manifest, and its directory on disk.
+
+On disk a rulebook is a directory::
+
+    rulebook.toml      manifest: name, format version, bounds mode, provenance (see .manifest)
+    goal_bias.fis      one text file per output FIS (see .text_format)
+    bound_1.fis ... bound_4.fis
+    step_size.fis
+
+Other files in the directory (e.g. a trainer's ``history.csv``) are left alone; an unknown
+``*.fis`` file is reported, because it is almost certainly a misnamed output.
+
+:func:`load_rulebook` validates everything and raises :class:`~xfuzzy_rrt.errors.RulebookError`
+with *all* problems as ``(file, line, message)``. :func:`save_rulebook` writes the canonical
+text; a canonical directory loads and saves back to identical bytes.
+
+``Rulebook.sha256`` identifies a rulebook in results: the SHA-256 over the canonical bytes of
+the manifest and the six FIS files, in the order ``rulebook.toml``, then OUTPUTS order, each
+fed as ``<file name>\\n<byte length>\\n<bytes>`` (so file boundaries are unambiguous). For a
+canonical directory (every shipped or saved one) these are exactly the bytes on disk; a
+hand-edited file with extra comments hashes as its canonical form, i.e. comments do not change
+a rulebook's identity, numbers do.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import tempfile
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from xfuzzy_rrt.errors import RulebookError
+from xfuzzy_rrt.fuzzy.manifest import (
+    BOUNDS_MODES,
+    MANIFEST_NAME,
+    Manifest,
+    format_manifest,
+    parse_manifest,
+)
+from xfuzzy_rrt.fuzzy.system import FuzzySystem, InputPartition
+from xfuzzy_rrt.fuzzy.text_format import SUFFIX, format_fis, parse_fis
+from xfuzzy_rrt.fuzzy.variables import (
+    DEFAULT_TERMS,
+    INPUTS,
+    N_INPUTS,
+    N_OUTPUTS,
+    N_RULES,
+    N_TERMS,
+    OUTPUTS,
+)
+
+#: Environment variable naming a folder of rulebooks that replaces the shipped one.
+RULEBOOKS_ENV = "XFUZZY_RRT_RULEBOOKS"
+DEFAULT_RULEBOOK = "expert"
+
+__all__ = [
+    "FuzzySystem",
+    "InputPartition",
+    "Rulebook",
+    "default_rulebook_path",
+    "fis_file_name",
+    "list_rulebooks",
+    "load_rulebook",
+    "rulebooks_dir",
+    "save_rulebook",
+]
+
+
+def fis_file_name(output: str) -> str:
+    """File name of the FIS for *output* inside a rulebook directory."""
+    return output + SUFFIX
+
+
+@dataclass(frozen=True)
+class Rulebook:
+    """Six single-output TSK systems (OUTPUTS order) with a name, bounds mode and provenance."""
+
+    name: str
+    bounds_mode: str
+    systems: tuple[FuzzySystem, ...]
+    provenance: Mapping[str, Any] = field(default_factory=dict)
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "systems", tuple(self.systems))
+        outputs = tuple(s.output for s in self.systems)
+        if outputs != OUTPUTS:
+            raise ValueError(f"systems must be {OUTPUTS} in that order, got {outputs}")
+        for s in self.systems:
+            if not isinstance(s, FuzzySystem):
+                raise ValueError(f"systems must be FuzzySystem objects, got {type(s).__name__}")
+        manifest = Manifest(
+            name=self.name, bounds_mode=self.bounds_mode,
+            provenance=self.provenance, description=self.description,
+        )  # validates; also freezes provenance
+        object.__setattr__(self, "provenance", manifest.provenance)
+
+    def __reduce__(self):
+        """Pickle via plain values: benchmark and training workers receive rulebooks, and the
+        read-only provenance views cannot be pickled as they are."""
+        from xfuzzy_rrt.fuzzy.manifest import thaw
+
+        return (_rebuild, (self.name, self.bounds_mode, self.systems, thaw(self.provenance),
+                           self.description))
+
+    # ------------------------------------------------------------------ views
+
+    @property
+    def manifest(self) -> Manifest:
+        return Manifest(
+            name=self.name, bounds_mode=self.bounds_mode,
+            provenance=self.provenance, description=self.description,
+        )
+
+    def system(self, output: str) -> FuzzySystem:
+        """The FIS for *output* (one of OUTPUTS)."""
+        try:
+            return self.systems[OUTPUTS.index(output)]
+        except ValueError:
+            raise KeyError(f"unknown output {output!r}; outputs are {OUTPUTS}") from None
+
+    def texts(self) -> dict[str, str]:
+        """Canonical text of every file, keyed by file name (manifest first, then OUTPUTS)."""
+        out = {MANIFEST_NAME: format_manifest(self.manifest)}
+        for s in self.systems:
+            out[fis_file_name(s.output)] = format_fis(s)
+        return out
+
+    @cached_property
+    def sha256(self) -> str:
+        """Hex SHA-256 of the canonical files (see the module docstring for the exact recipe)."""
+        h = hashlib.sha256()
+        for file, text in self.texts().items():
+            data = text.encode("utf-8")
+            h.update(f"{file}\n{len(data)}\n".encode("ascii"))
+            h.update(data)
+        return h.hexdigest()
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """Fresh C-contiguous ``(knots float64[6, 4, 5], consts float64[6, 625])`` for the engine."""
+        knots = np.empty((N_OUTPUTS, N_INPUTS, N_TERMS), dtype=np.float64)
+        consts = np.empty((N_OUTPUTS, N_RULES), dtype=np.float64)
+        for f, s in enumerate(self.systems):
+            for i, inp in enumerate(s.inputs):
+                knots[f, i, :] = inp.peaks
+            consts[f, :] = s.consts
+        return knots, consts
+
+    # ------------------------------------------------------------ construction
+
+    @classmethod
+    def from_arrays(
+        cls,
+        knots,
+        consts,
+        *,
+        name: str,
+        bounds_mode: str,
+        provenance: Mapping[str, Any] | None = None,
+        description: str = "",
+        term_names: Mapping[str, tuple[str, ...]] | None = None,
+    ) -> "Rulebook":
+        """Build a rulebook from engine arrays (what the GA trainer evolves).
+
+        ``knots[f, i]`` must be ``[lo, p1, p2, p3, hi]`` with the input's exact range ends and
+        strictly increasing peaks; ``consts`` must lie within each output's range (clip them
+        before calling). Term names default to :data:`~.variables.DEFAULT_TERMS`. Raises
+        ``ValueError`` naming the offending FIS, input or rule.
+        """
+        knots = np.asarray(knots, dtype=np.float64)
+        consts = np.asarray(consts, dtype=np.float64)
+        if knots.shape != (N_OUTPUTS, N_INPUTS, N_TERMS):
+            raise ValueError(f"knots must have shape {(N_OUTPUTS, N_INPUTS, N_TERMS)}, got {knots.shape}")
+        if consts.shape != (N_OUTPUTS, N_RULES):
+            raise ValueError(f"consts must have shape {(N_OUTPUTS, N_RULES)}, got {consts.shape}")
+        names = dict(DEFAULT_TERMS)
+        if term_names:
+            names.update({k: tuple(v) for k, v in term_names.items()})
+        systems = []
+        for f, output in enumerate(OUTPUTS):
+            inputs = tuple(
+                InputPartition(name=inp, terms=names[inp], peaks=tuple(knots[f, i].tolist()))
+                for i, inp in enumerate(INPUTS)
+            )
+            systems.append(FuzzySystem(output=output, inputs=inputs, consts=tuple(consts[f].tolist())))
+        return cls(
+            name=name, bounds_mode=bounds_mode, systems=tuple(systems),
+            provenance=dict(provenance or {}), description=description,
+        )
+
+
+def _rebuild(name, bounds_mode, systems, provenance, description) -> "Rulebook":
+    return Rulebook(name=name, bounds_mode=bounds_mode, systems=systems, provenance=provenance,
+                    description=description)
+
+
+# ------------------------------------------------------------------------- locations
+
+
+def rulebooks_dir() -> Path:
+    """Folder holding the shipped rulebooks (``$XFUZZY_RRT_RULEBOOKS`` overrides it)."""
+    env = os.environ.get(RULEBOOKS_ENV)
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[2] / "rulebooks"
+
+
+def default_rulebook_path() -> Path:
+    """Directory of the default rulebook (``expert``; hand-written until training exists)."""
+    return rulebooks_dir() / DEFAULT_RULEBOOK
+
+
+def list_rulebooks() -> list[Path]:
+    """Rulebook directories (those with a manifest) in :func:`rulebooks_dir`, sorted by name."""
+    root = rulebooks_dir()
+    if not root.is_dir():
+        return []
+    return sorted(p for p in root.iterdir() if (p / MANIFEST_NAME).is_file())
+
+
+# ------------------------------------------------------------------------- load / save
+
+
+def _read(path: Path, problems: list) -> bytes | None:
+    try:
+        return path.read_bytes()
+    except FileNotFoundError:
+        problems.append((str(path), None, "missing file"))
+    except IsADirectoryError:
+        problems.append((str(path), None, "is a directory, expected a file"))
+    except OSError as exc:
+        problems.append((str(path), None, f"cannot read: {exc.strerror or exc}"))
+    return None
+
+
+def load_rulebook(path: str | os.PathLike[str]) -> Rulebook:
+    """Read and validate the rulebook directory *path*.
+
+    Raises :class:`RulebookError` listing every problem found in every file (the directory
+    itself missing or unreadable is reported the same way).
+    """
+    root = Path(path)
+    if not root.exists():
+        raise RulebookError([(str(root), None, "rulebook directory does not exist")])
+    if not root.is_dir():
+        raise RulebookError([(str(root), None, "not a directory (a rulebook is a directory)")])
+    problems: list[tuple[str, int | None, str]] = []
+    try:
+        extra = sorted(
+            p.name for p in root.iterdir()
+            if p.suffix == SUFFIX and p.stem not in OUTPUTS
+        )
+    except OSError as exc:
+        raise RulebookError([(str(root), None, f"cannot list directory: {exc.strerror or exc}")]) from None
+    for name in extra:
+        problems.append(
+            (str(root / name), None, f"unexpected FIS file (outputs are {', '.join(OUTPUTS)})")
+        )
+    manifest = None
+    data = _read(root / MANIFEST_NAME, problems)
+    if data is not None:
+        manifest, found = parse_manifest(data, str(root / MANIFEST_NAME))
+        problems.extend(found)
+    systems = []
+    for output in OUTPUTS:
+        file = root / fis_file_name(output)
+        data = _read(file, problems)
+        if data is None:
+            continue
+        fis, found = parse_fis(data, str(file), output)
+        problems.extend(found)
+        systems.append(fis)
+    if problems:
+        raise RulebookError(problems)
+    return Rulebook(
+        name=manifest.name, bounds_mode=manifest.bounds_mode, systems=tuple(systems),
+        provenance=manifest.provenance, description=manifest.description,
+    )
+
+
+def save_rulebook(rulebook: Rulebook, path: str | os.PathLike[str]) -> Path:
+    """Write *rulebook* canonically into directory *path* (created if needed); return it.
+
+    All seven texts are rendered first, then written to temporary files beside their
+    destinations, then renamed into place; a failure before the renames leaves the directory
+    as it was (no partial files). Files other than the rulebook's own are not touched.
+    """
+    if not isinstance(rulebook, Rulebook):
+        raise TypeError(f"expected a Rulebook, got {type(rulebook).__name__}")
+    return write_files(path, rulebook.texts())
+
+
+def write_files(path: str | os.PathLike[str], texts: Mapping[str, str]) -> Path:
+    """Write several text files into directory *path* all-or-nothing (as far as POSIX allows).
+
+    Every text goes to a temporary file beside its destination first; only when all are
+    written are they renamed into place (``os.replace``, atomic per file).
+    """
+    root = Path(path)
+    if root.exists() and not root.is_dir():
+        raise NotADirectoryError(f"{root} exists and is not a directory")
+    root.mkdir(parents=True, exist_ok=True)
+    temps: list[tuple[Path, Path]] = []
+    try:
+        for file, text in texts.items():
+            fd, tmp = tempfile.mkstemp(prefix=f".{file}.", suffix=".tmp", dir=root)
+            temps.append((Path(tmp), root / file))
+            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
+                fh.write(text)
+            os.chmod(tmp, 0o644)  # mkstemp makes 0600; rulebooks are meant to be shared
+        for tmp, dest in temps:
+            os.replace(tmp, dest)
+    except BaseException:
+        for tmp, _ in temps:
+            try:
+                tmp.unlink()
+            except FileNotFoundError:
+                pass
+        raise
+    return root
+
+
+__all__ += ["BOUNDS_MODES"]

@@ -1,0 +1,125 @@
+"""The frozen model of one single-output fuzzy inference system (FIS) and its inputs.
+
+A Fuzzy-RRT rulebook holds six of these (one per output, as in the paper). Objects are
+immutable and validated on construction with real exceptions (``ValueError``), so a
+:class:`FuzzySystem` that exists is always a usable one; the text parser
+(:mod:`.text_format`) performs the same checks first to report them with file and line.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from xfuzzy_rrt.fuzzy.variables import (
+    INPUT_RANGES,
+    INPUTS,
+    N_RULES,
+    N_TERMS,
+    OUTPUT_RANGES,
+    OUTPUTS,
+)
+
+#: Term names are identifiers (letters, digits, underscores; not starting with a digit) and
+#: cannot be one of the words the rule grammar uses.
+TERM_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+RESERVED = frozenset({"if", "is", "and", "then", "or", "not"})
+
+
+def term_name_problem(name: str) -> str | None:
+    """Why *name* cannot be a term name, or ``None`` when it can."""
+    if not TERM_NAME.match(name):
+        return f"term name {name!r} is not an identifier (letters, digits, _)"
+    if name in RESERVED:
+        return f"term name {name!r} is a reserved word"
+    return None
+
+
+def peaks_problem(peaks: tuple[float, ...], lo: float, hi: float) -> str | None:
+    """Why *peaks* (``[lo, p1, p2, p3, hi]``) is not a valid partition of ``[lo, hi]``."""
+    if len(peaks) != N_TERMS:
+        return f"expected {N_TERMS} peaks, got {len(peaks)}"
+    if not all(math.isfinite(p) for p in peaks):
+        return "peaks must be finite numbers"
+    if peaks[0] != lo or peaks[-1] != hi:
+        return (
+            f"first and last peaks must be the range ends {lo!r} and {hi!r} (the shoulders), "
+            f"got {peaks[0]!r} and {peaks[-1]!r}"
+        )
+    inner = peaks[1:-1]
+    outside = [p for p in inner if not lo < p < hi]
+    if outside:
+        return f"peak {outside[0]!r} outside the input range ({lo!r}, {hi!r})"
+    if not all(a < b for a, b in zip(peaks, peaks[1:])):
+        return "peaks are not strictly increasing: " + " ".join(repr(p) for p in peaks)
+    return None
+
+
+@dataclass(frozen=True)
+class InputPartition:
+    """One input of a FIS: its name, range, five term names and the five term peaks.
+
+    ``peaks`` is the knot row ``[lo, p1, p2, p3, hi]`` of the engine: term ``j`` has its peak
+    (membership 1) at ``peaks[j]``; the first and last terms are shoulders.
+    """
+
+    name: str
+    terms: tuple[str, ...]
+    peaks: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if self.name not in INPUT_RANGES:
+            raise ValueError(f"unknown input variable {self.name!r}; inputs are {INPUTS}")
+        object.__setattr__(self, "terms", tuple(str(t) for t in self.terms))
+        object.__setattr__(self, "peaks", tuple(float(p) for p in self.peaks))
+        if len(self.terms) != N_TERMS:
+            raise ValueError(f"{self.name}: expected {N_TERMS} terms, got {len(self.terms)}")
+        for t in self.terms:
+            problem = term_name_problem(t)
+            if problem:
+                raise ValueError(f"{self.name}: {problem}")
+        if len(set(self.terms)) != N_TERMS:
+            raise ValueError(f"{self.name}: term names must be distinct: {self.terms}")
+        problem = peaks_problem(self.peaks, *self.range)
+        if problem:
+            raise ValueError(f"{self.name}: {problem}")
+
+    @property
+    def range(self) -> tuple[float, float]:
+        """The variable's range (fixed by SPEC.md, not per rulebook)."""
+        return INPUT_RANGES[self.name]
+
+
+@dataclass(frozen=True)
+class FuzzySystem:
+    """A zero-order Takagi-Sugeno system with one output and the 625-rule grid.
+
+    ``consts[r]`` is the consequent of rule ``r`` (index convention in :mod:`.variables`).
+    """
+
+    output: str
+    inputs: tuple[InputPartition, ...]
+    consts: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if self.output not in OUTPUT_RANGES:
+            raise ValueError(f"unknown output variable {self.output!r}; outputs are {OUTPUTS}")
+        object.__setattr__(self, "inputs", tuple(self.inputs))
+        object.__setattr__(self, "consts", tuple(float(c) for c in self.consts))
+        names = tuple(i.name for i in self.inputs)
+        if names != INPUTS:
+            raise ValueError(f"{self.output}: inputs must be {INPUTS} in that order, got {names}")
+        if len(self.consts) != N_RULES:
+            raise ValueError(f"{self.output}: expected {N_RULES} rule constants, got {len(self.consts)}")
+        lo, hi = self.range
+        for r, c in enumerate(self.consts):
+            if not (math.isfinite(c) and lo <= c <= hi):
+                raise ValueError(
+                    f"{self.output}: rule {r} constant {c!r} outside the output range [{lo!r}, {hi!r}]"
+                )
+
+    @property
+    def range(self) -> tuple[float, float]:
+        """The output's range (fixed by SPEC.md)."""
+        return OUTPUT_RANGES[self.output]

@@ -1,0 +1,479 @@
+"""The FIS text format (``<output>.fis``): parse, format and every lint check.
+
+Why this shape: a person must be able to answer "what does the planner do when the goal is
+near and no obstacle is close?" with one ``grep``, review a retrained rulebook as a diff, and
+edit a number by hand. So every rule is one self-contained sentence on its own line, in a fixed
+order, and every number is written as Python's ``repr(float)`` (the shortest text that reads
+back as the same float), which makes ``load -> save`` byte-identical and floats exact.
+
+Example (``goal_bias.fis``, abridged)::
+
+    # xfuzzy-rrt fuzzy inference system: goal_bias
+    # ... (explanatory comment header)
+    format xfuzzy-rrt-fis 1
+    output goal_bias range 0.0 1.0
+
+    input angle_to_goal range 0.0 6.283185307179586
+      terms east_0 north west south east_2pi
+      peaks 0.0 1.5707963267948966 3.141592653589793 4.71238898038469 6.283185307179586
+    input dist_to_goal range 0.0 0.6
+      terms very_near near medium far very_far
+      peaks 0.0 0.15 0.3 0.45 0.6
+    ...
+
+    # angle_to_goal is east_0, dist_to_goal is very_near
+    r0: if angle_to_goal is east_0 and dist_to_goal is very_near and angle_to_obstacle is east_0 and dist_to_obstacle is very_near then goal_bias = 0.05
+    ...
+    end
+
+Grammar (one statement per line; ``#`` starts a comment anywhere; blank lines are ignored;
+indentation is free; ``\\r\\n`` and a UTF-8 BOM are tolerated):
+
+- ``format xfuzzy-rrt-fis 1`` — must be the first statement.
+- ``output NAME range LO HI`` — NAME must be the file's stem; the range must be the SPEC range.
+- ``input NAME range LO HI`` followed by ``terms T0 T1 T2 T3 T4`` and
+  ``peaks LO P1 P2 P3 HI`` — the four inputs, in the fixed order. Term ``j`` peaks at
+  ``peaks[j]``; the first and last are shoulders, so the first and last peaks must be the
+  range ends and the peaks strictly increasing.
+- ``[rN:] if IN is TERM and IN is TERM and IN is TERM and IN is TERM then OUTPUT = VALUE`` —
+  one per antecedent, 625 in all. The ``rN:`` label is optional when reading but, if present,
+  must be the rule's index ``((t0*5 + t1)*5 + t2)*5 + t3``; the four inputs may appear in any
+  order. VALUE must lie within the output range.
+- ``end`` — must close the file (so that a truncated file is recognised as such).
+
+Comments on save: saving writes the *canonical* layout — the fixed comment header, one
+``# <input 0> is ..., <input 1> is ...`` comment above each block of 25 rules, rules in index
+order with their ``rN:`` labels, numbers as ``repr``. Comments and blank lines added by hand are
+**not** preserved (keep notes in the manifest's ``description`` or ``provenance`` instead), and
+a hand-reordered file is written back in index order. A canonical file reads and writes back
+to identical bytes.
+
+All checks collect *every* problem in one pass as ``(file, line, message)``; nothing stops at
+the first.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+import re
+from dataclasses import dataclass, field
+
+from xfuzzy_rrt.fuzzy.system import (
+    FuzzySystem,
+    InputPartition,
+    peaks_problem,
+    term_name_problem,
+)
+from xfuzzy_rrt.fuzzy.variables import (
+    INPUT_RANGES,
+    INPUTS,
+    N_RULES,
+    N_TERMS,
+    OUTPUT_RANGES,
+    rule_index,
+    rule_terms,
+)
+
+FORMAT_NAME = "xfuzzy-rrt-fis"
+FORMAT_VERSION = 1
+SUFFIX = ".fis"
+
+Problem = tuple[str, "int | None", str]
+
+_RULE = re.compile(
+    r"(?:r(?P<label>[0-9]+)\s*:\s*)?if\s+(?P<ante>.+?)\s+then\s+(?P<out>\S+)\s*=\s*(?P<value>\S+)\Z"
+)
+_CLAUSE = re.compile(r"(?P<var>\S+)\s+is\s+(?P<term>\S+)\Z")
+_AND = re.compile(r"\s+and\s+")
+_LABEL = re.compile(r"r([0-9]+)\s*:")
+_LABEL_BYTES = re.compile(rb"\s*r([0-9]+)\s*:")
+
+
+def fnum(value: float) -> str:
+    """A float as the shortest text that reads back exactly (``repr``)."""
+    return repr(float(value))
+
+
+def _parse_float(text: str) -> float | None:
+    """A finite float from *text*, or ``None`` (``nan``/``inf`` are not numbers here)."""
+    try:
+        v = float(text)
+    except ValueError:
+        return None
+    return v if math.isfinite(v) else None
+
+
+# --------------------------------------------------------------------------------- format
+
+
+def header_comment(output: str) -> list[str]:
+    """The fixed explanatory comment at the top of every canonical FIS file."""
+    lo, hi = OUTPUT_RANGES[output]
+    return [
+        f"# xfuzzy-rrt fuzzy inference system: {output} (range {fnum(lo)} .. {fnum(hi)})",
+        "#",
+        "# Zero-order Takagi-Sugeno: a rule fires with the product of its four memberships;",
+        f"# {output} is the firing-weighted average of the rule constants.",
+        "# Each input has five terms; term j peaks at peaks[j] and falls to 0 at the",
+        "# neighbouring peaks (the first and last are shoulders). Inputs outside a range are",
+        "# clamped to it. Angles are workspace directions counter-clockwise from +x in radians",
+        "# (0 and 2*pi are both east); distances are in metres.",
+        "# Rules: one per line, in index order r = ((t0*5 + t1)*5 + t2)*5 + t3 (t = term index).",
+        "# Edit numbers freely; '#' comments are ignored but not kept when a tool saves the file.",
+    ]
+
+
+def format_fis(fis: FuzzySystem) -> str:
+    """The canonical text of *fis* (``\\n`` line ends, trailing newline)."""
+    lo, hi = fis.range
+    lines = header_comment(fis.output)
+    lines.append(f"format {FORMAT_NAME} {FORMAT_VERSION}")
+    lines.append(f"output {fis.output} range {fnum(lo)} {fnum(hi)}")
+    lines.append("")
+    for inp in fis.inputs:
+        ilo, ihi = inp.range
+        lines.append(f"input {inp.name} range {fnum(ilo)} {fnum(ihi)}")
+        lines.append("  terms " + " ".join(inp.terms))
+        lines.append("  peaks " + " ".join(fnum(p) for p in inp.peaks))
+    names = [inp.name for inp in fis.inputs]
+    terms = [inp.terms for inp in fis.inputs]
+    block = N_TERMS * N_TERMS
+    for r, c in enumerate(fis.consts):
+        t = rule_terms(r)
+        if r % block == 0:
+            lines.append("")
+            lines.append(f"# {names[0]} is {terms[0][t[0]]}, {names[1]} is {terms[1][t[1]]}")
+        ante = " and ".join(f"{names[i]} is {terms[i][t[i]]}" for i in range(len(names)))
+        lines.append(f"r{r}: if {ante} then {fis.output} = {fnum(c)}")
+    lines.append("end")
+    return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------------------------- parse
+
+
+@dataclass
+class _InputDecl:
+    name: str
+    line: int
+    terms: tuple[str, ...] | None = None
+    peaks: tuple[float, ...] | None = None
+    terms_ok: bool = False
+    peaks_ok: bool = False
+
+
+@dataclass
+class _State:
+    file: str
+    expected_output: str
+    problems: list[Problem] = field(default_factory=list)
+    saw_format: bool = False
+    output_line: int | None = None
+    output_ok: bool = False
+    inputs: list[_InputDecl] = field(default_factory=list)
+    rules: dict[int, tuple[int, float]] = field(default_factory=dict)  # r -> (line, value)
+    # labels of rule lines that were reported as broken: not reported again as "missing"
+    attempted: set[int] = field(default_factory=set)
+    end_line: int | None = None
+
+    def problem(self, line: int | None, message: str) -> None:
+        self.problems.append((self.file, line, message))
+
+
+def decode_lines(data: bytes, file: str) -> tuple[list[str | None], list[Problem]]:
+    """Split *data* into text lines; a line that is not UTF-8 becomes ``None`` plus a problem.
+
+    Decoding line by line (rather than the whole file) lets lint report *which* lines are
+    broken and still check the rest.
+    """
+    problems: list[Problem] = []
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    raw = data.split(b"\n")
+    if raw and raw[-1] == b"":
+        raw.pop()
+    lines: list[str | None] = []
+    for n, chunk in enumerate(raw, start=1):
+        try:
+            text = chunk.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            problems.append(
+                (file, n, f"not valid UTF-8 (byte 0x{chunk[exc.start]:02x} at column {exc.start + 1})")
+            )
+            lines.append(None)
+            continue
+        lines.append(text[:-1] if text.endswith("\r") else text)
+    return lines, problems
+
+
+def parse_fis(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem | None, list[Problem]]:
+    """Parse one FIS file. Returns the system (``None`` if anything is wrong) and all problems.
+
+    *file* is the name used in problem messages; *expected_output* is the output this file must
+    describe (its stem).
+    """
+    lines, problems = decode_lines(data, file)
+    st = _State(file=file, expected_output=expected_output, problems=problems)
+    raw_lines = data.split(b"\n") if problems else []
+    last_line = 0
+    for n, raw in enumerate(lines, start=1):
+        if raw is None:
+            m = _LABEL_BYTES.match(raw_lines[n - 1]) if n - 1 < len(raw_lines) else None
+            if m:
+                st.attempted.add(int(m.group(1)))
+            continue
+        text = raw.split("#", 1)[0].strip()
+        if not text:
+            continue
+        last_line = n
+        if st.end_line is not None:
+            st.problem(n, f"statement after 'end' (line {st.end_line}): {text[:60]!r}")
+            continue
+        _statement(st, n, text)
+    _finish(st, len(lines), last_line)
+    if st.problems:
+        return None, st.problems
+    return _build(st), []
+
+
+def _statement(st: _State, n: int, text: str) -> None:
+    words = text.split()
+    key = words[0]
+    if not st.saw_format and key != "format":
+        st.problem(n, f"the first statement must be 'format {FORMAT_NAME} {FORMAT_VERSION}'")
+        st.saw_format = True  # report once
+    if key == "format":
+        st.saw_format = True
+        if words[1:] != [FORMAT_NAME, str(FORMAT_VERSION)]:
+            st.problem(n, f"unsupported format {' '.join(words[1:])!r} (expected '{FORMAT_NAME} {FORMAT_VERSION}')")
+    elif key == "output":
+        _output(st, n, words)
+    elif key == "input":
+        _input(st, n, words)
+    elif key in ("terms", "peaks"):
+        _input_detail(st, n, key, words)
+    elif key == "end":
+        if len(words) != 1:
+            st.problem(n, "'end' takes no arguments")
+        st.end_line = n
+    elif key == "if" or re.match(r"r[0-9]+\s*:", text):
+        _rule(st, n, text)
+    else:
+        st.problem(n, f"unknown statement {key!r} (expected format, output, input, terms, peaks, a rule or end)")
+
+
+def _range_problem(words: list[str], expected: tuple[float, float], what: str) -> str | None:
+    """Check ``... range LO HI`` in words[2:]; return a problem or None."""
+    if len(words) != 5 or words[2] != "range":
+        return f"expected '{words[0]} {what} range LO HI'"
+    lo, hi = _parse_float(words[3]), _parse_float(words[4])
+    if lo is None or hi is None:
+        return f"range of {what} must be two finite numbers, got {words[3]!r} {words[4]!r}"
+    if (lo, hi) != expected:
+        return f"range of {what} must be {fnum(expected[0])} {fnum(expected[1])} (SPEC.md), got {words[3]} {words[4]}"
+    return None
+
+
+def _output(st: _State, n: int, words: list[str]) -> None:
+    if st.output_line is not None:
+        st.problem(n, f"second 'output' declaration (first on line {st.output_line})")
+        return
+    st.output_line = n
+    name = words[1] if len(words) > 1 else ""
+    if name != st.expected_output:
+        st.problem(n, f"wrong output variable {name!r}: this file describes {st.expected_output!r}")
+        return
+    problem = _range_problem(words, OUTPUT_RANGES[name], name)
+    if problem:
+        st.problem(n, problem)
+    st.output_ok = True
+
+
+def _input(st: _State, n: int, words: list[str]) -> None:
+    k = len(st.inputs)
+    name = words[1] if len(words) > 1 else ""
+    expected = INPUTS[k] if k < len(INPUTS) else None
+    if expected is None:
+        st.problem(n, f"too many inputs: {name!r} (a FIS has exactly {len(INPUTS)}: {', '.join(INPUTS)})")
+        st.inputs.append(_InputDecl(name=name, line=n))
+        return
+    decl = _InputDecl(name=name, line=n)
+    st.inputs.append(decl)
+    if name != expected:
+        hint = "unknown input variable" if name not in INPUTS else "input out of order"
+        st.problem(n, f"{hint} {name!r} (input {k + 1} must be {expected!r})")
+        decl.name = expected  # check the rest as if it were the expected one
+        decl.line = n
+        return
+    problem = _range_problem(words, INPUT_RANGES[name], name)
+    if problem:
+        st.problem(n, problem)
+
+
+def _input_detail(st: _State, n: int, key: str, words: list[str]) -> None:
+    if not st.inputs:
+        st.problem(n, f"'{key}' outside an input declaration")
+        return
+    decl = st.inputs[-1]
+    if (decl.terms if key == "terms" else decl.peaks) is not None:
+        st.problem(n, f"second '{key}' line for input {decl.name!r}")
+        return
+    values = words[1:]
+    if key == "terms":
+        decl.terms = tuple(values)
+        ok = True
+        if len(values) != N_TERMS:
+            st.problem(n, f"input {decl.name!r} needs {N_TERMS} terms, got {len(values)}")
+            ok = False
+        for t in values:
+            problem = term_name_problem(t)
+            if problem:
+                st.problem(n, problem)
+                ok = False
+        dupes = sorted({t for t in values if values.count(t) > 1})
+        if dupes:
+            st.problem(n, f"duplicate term name(s) {', '.join(dupes)} for input {decl.name!r}")
+            ok = False
+        decl.terms_ok = ok
+    else:
+        parsed = [_parse_float(v) for v in values]
+        bad = [v for v, p in zip(values, parsed) if p is None]
+        decl.peaks = tuple(p if p is not None else math.nan for p in parsed)
+        if bad:
+            st.problem(n, f"peak {bad[0]!r} of {decl.name!r} is not a finite number")
+            return
+        lo, hi = INPUT_RANGES.get(decl.name, (math.nan, math.nan))
+        problem = peaks_problem(decl.peaks, lo, hi)
+        if problem:
+            st.problem(n, f"{decl.name}: {problem}")
+            return
+        decl.peaks_ok = True
+
+
+def _rule(st: _State, n: int, text: str) -> None:
+    text = " ".join(text.split())
+    label_match = _LABEL.match(text)
+    if label_match:
+        st.attempted.add(int(label_match.group(1)))
+    m = _RULE.match(text)
+    if not m:
+        st.problem(n, "malformed rule (expected 'if IN is TERM and ... then OUTPUT = VALUE')")
+        return
+    clauses = _AND.split(m.group("ante"))
+    by_var: dict[str, str] = {}
+    ok = True
+    for clause in clauses:
+        cm = _CLAUSE.match(clause)
+        if not cm:
+            st.problem(n, f"malformed condition {clause!r} (expected 'INPUT is TERM')")
+            ok = False
+            continue
+        var, term = cm.group("var"), cm.group("term")
+        if var not in INPUTS:
+            st.problem(n, f"unknown input variable {var!r} in rule (inputs: {', '.join(INPUTS)})")
+            ok = False
+            continue
+        if var in by_var:
+            st.problem(n, f"input {var!r} appears twice in rule")
+            ok = False
+            continue
+        by_var[var] = term
+    missing = [v for v in INPUTS if v not in by_var]
+    if ok and missing:
+        st.problem(n, f"rule has no condition on {', '.join(missing)} (every rule names all four inputs)")
+        ok = False
+    t_idx: list[int] = []
+    decls = {d.name: d for d in st.inputs[: len(INPUTS)]}
+    for var in INPUTS:
+        if var not in by_var:
+            continue
+        decl = decls.get(var)
+        if decl is None or not decl.terms_ok:
+            ok = False  # the input's own declaration is already reported (or missing: reported at the end)
+            continue
+        term = by_var[var]
+        if term not in decl.terms:
+            st.problem(n, f"unknown term {term!r} for {var} (terms: {' '.join(decl.terms)})")
+            ok = False
+            continue
+        t_idx.append(decl.terms.index(term))
+    out = m.group("out")
+    if out != st.expected_output:
+        st.problem(n, f"rule concludes {out!r} but this file describes {st.expected_output!r}")
+    value = _parse_float(m.group("value"))
+    lo, hi = OUTPUT_RANGES[st.expected_output]
+    if value is None:
+        st.problem(n, f"consequent {m.group('value')!r} is not a finite number")
+    elif not lo <= value <= hi:
+        st.problem(n, f"consequent {m.group('value')} outside the output range [{fnum(lo)}, {fnum(hi)}] of {st.expected_output}")
+    if not ok or len(t_idx) != len(INPUTS):
+        return
+    r = rule_index(t_idx)
+    label = m.group("label")
+    if label is not None and int(label) != r:
+        st.problem(n, f"rule label r{label} does not match its conditions (they make rule r{r})")
+        return
+    if r in st.rules:
+        st.problem(n, f"duplicate rule r{r}: same conditions as line {st.rules[r][0]}")
+        return
+    st.rules[r] = (n, value if value is not None else math.nan)
+
+
+def _finish(st: _State, n_lines: int, last_line: int) -> None:
+    """File-level checks once every line has been seen."""
+    at_end = last_line if last_line else (n_lines or 1)
+    if not st.saw_format:
+        st.problem(at_end, "empty file (no statements)")
+        return
+    if st.output_line is None:
+        st.problem(at_end, f"missing 'output {st.expected_output} range LO HI' declaration")
+    for decl in st.inputs[: len(INPUTS)]:
+        if decl.terms is None:
+            st.problem(decl.line, f"input {decl.name!r} has no 'terms' line")
+        if decl.peaks is None:
+            st.problem(decl.line, f"input {decl.name!r} has no 'peaks' line")
+    for name in INPUTS[len(st.inputs):]:
+        st.problem(at_end, f"missing declaration of input {name!r}")
+    inputs_ok = len(st.inputs) >= len(INPUTS) and all(
+        d.terms_ok for d in st.inputs[: len(INPUTS)]
+    )
+    if inputs_ok:
+        _report_missing_rules(st, at_end)
+    if st.end_line is None:
+        st.problem(at_end, f"file ends without 'end' (truncated? {len(st.rules)} of {N_RULES} rules read)")
+
+
+def _report_missing_rules(st: _State, at_end: int) -> None:
+    """Group missing rule indices into runs; report each run where it belongs."""
+    present = sorted(st.rules)
+    missing = [r for r in range(N_RULES) if r not in st.rules and r not in st.attempted]
+    if not missing:
+        return
+    runs: list[tuple[int, int]] = []
+    start = prev = missing[0]
+    for r in missing[1:]:
+        if r != prev + 1:
+            runs.append((start, prev))
+            start = r
+        prev = r
+    runs.append((start, prev))
+    decls = st.inputs[: len(INPUTS)]
+    for a, b in runs:
+        # the line of the next present rule (where the missing one belongs), else the end
+        i = bisect.bisect_right(present, b)
+        line = st.rules[present[i]][0] if i < len(present) else (st.end_line or at_end)
+        if a == b:
+            t = rule_terms(a)
+            ante = " and ".join(f"{d.name} is {d.terms[t[k]]}" for k, d in enumerate(decls))
+            st.problem(line, f"missing rule r{a}: if {ante}")
+        else:
+            st.problem(line, f"missing rules r{a}..r{b} ({b - a + 1} rules)")
+
+
+def _build(st: _State) -> FuzzySystem:
+    inputs = tuple(
+        InputPartition(name=d.name, terms=d.terms, peaks=d.peaks) for d in st.inputs
+    )
+    consts = tuple(st.rules[r][1] for r in range(N_RULES))
+    return FuzzySystem(output=st.expected_output, inputs=inputs, consts=consts)

@@ -1,0 +1,1 @@
+"""Views over traces and rulebooks for auditors: explanations, firing statistics."""

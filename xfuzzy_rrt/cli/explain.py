@@ -1,0 +1,27 @@
+"""``xfuzzy-rrt explain``: show how one Fuzzy-RRT expansion was decided, rule by rule."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+
+def explain(
+    source: Path = typer.Argument(..., help="A trace (.parquet/.csv) or a plan result (.json)."),
+    iteration: int = typer.Option(..., "--iteration", min=1, help="Iteration to explain (1-based)."),
+    rulebook: Optional[Path] = typer.Option(
+        None, "--rulebook", help="Rulebook that made the trace (default: the one the source names)."),
+) -> int:
+    """Print inputs, active terms, fired rules with strengths and contributions, and outputs."""
+    from xfuzzy_rrt.analysis.explain import explain_row, render_text, trace_row
+    from xfuzzy_rrt.planners.replay import trace_for
+
+    frame, rb = trace_for(source, rulebook)
+    typer.echo(render_text(explain_row(trace_row(frame, iteration), rb)), nl=False)
+    return 0
+
+
+def register(app: typer.Typer) -> None:
+    app.command("explain")(explain)

@@ -1,0 +1,88 @@
+"""The ``xfuzzy-rrt`` console script.
+
+Why a custom :func:`main` instead of calling the typer app directly: the contract in SPEC.md is
+that *every* bad input (a usage error, a bad scenario, a bad rulebook) produces exactly one line
+``error: <where>: <what>`` on stderr and exit code 2, never a traceback or a boxed help panel.
+So the app runs in non-standalone mode and this function maps exceptions to exit codes.
+
+Heavy libraries (numba, pandas, plotly) are imported inside the command functions so that
+``xfuzzy-rrt --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+
+from xfuzzy_rrt.errors import InputError, RulebookError
+
+app = typer.Typer(
+    name="xfuzzy-rrt",
+    help="Fuzzy-RRT motion planning for a 2-DOF surgical arm, with inspectable rulebooks.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    rich_markup_mode=None,
+)
+
+
+def _register() -> None:
+    from xfuzzy_rrt.cli import bench as bench_cli
+    from xfuzzy_rrt.cli import explain as explain_cli
+    from xfuzzy_rrt.cli import plan as plan_cli
+    from xfuzzy_rrt.cli import rules as rules_cli
+
+    plan_cli.register(app)
+    bench_cli.register(app)
+    explain_cli.register(app)
+    app.add_typer(rules_cli.app, name="rules")
+
+
+_register()
+
+
+def _print_error(line: str) -> None:
+    sys.stderr.write(f"error: {line}\n")
+    sys.stderr.flush()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; return (and, as a script, exit with) the process exit code."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    command = typer.main.get_command(app)
+    try:
+        rv = command.main(args=args, prog_name="xfuzzy-rrt", standalone_mode=False)
+    except RulebookError as exc:
+        for line in exc.lines():
+            _print_error(line)
+        code = 2
+    except InputError as exc:
+        _print_error(str(exc))
+        code = 2
+    except typer.exceptions.TyperException as exc:  # click usage errors live under this base
+        name = type(exc).__name__
+        if name == "NoArgsIsHelpError":
+            ctx = getattr(exc, "ctx", None)
+            sys.stdout.write((ctx.get_help() if ctx is not None else "") + "\n")
+            code = 0
+        else:
+            message = exc.format_message().replace("\n", " ").strip()
+            _print_error(message)
+            code = getattr(exc, "exit_code", 2) or 2
+    except typer.Exit as exc:
+        code = exc.exit_code
+    except typer.Abort:
+        _print_error("aborted")
+        code = 1
+    except KeyboardInterrupt:
+        code = 130
+    else:
+        code = rv if isinstance(rv, int) else 0
+    if argv is None:
+        sys.exit(code)
+    return code
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

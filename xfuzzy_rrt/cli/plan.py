@@ -1,0 +1,61 @@
+"""``xfuzzy-rrt plan``: plan one scenario and print (or write) the SPEC.md JSON result."""
+
+from __future__ import annotations
+
+import enum
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+
+class PlannerName(str, enum.Enum):
+    rrt = "rrt"
+    fuzzy_rrt = "fuzzy-rrt"
+
+
+def plan(
+    scenario: Path = typer.Argument(..., help="Scenario TOML file."),
+    planner: PlannerName = typer.Option(PlannerName.fuzzy_rrt, "--planner", help="Planner."),
+    rulebook: Optional[Path] = typer.Option(
+        None, "--rulebook", help="Rulebook directory (fuzzy-rrt; default: the shipped default)."),
+    seed: int = typer.Option(0, "--seed", help="Random seed."),
+    max_iter: int = typer.Option(10_000, "--max-iter", min=1, help="Iteration budget."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON here (default: stdout)."),
+    trace: Optional[Path] = typer.Option(
+        None, "--trace", help="Write the per-iteration trace (.parquet or .csv; fuzzy-rrt)."),
+    step_deg: float = typer.Option(10.0, "--step-deg", help="RRT step size in degrees."),
+    goal_bias: float = typer.Option(0.05, "--goal-bias", help="RRT goal bias in [0, 1]."),
+) -> int:
+    """Plan a path from the scenario's start to its goal. Exit 1 when no path is found."""
+    from xfuzzy_rrt.cli.common import emit_json, load_scenario_warn
+    from xfuzzy_rrt.planners.api import plan_scenario, write_trace_checked
+
+    if trace is not None:
+        write_trace_checked(trace)  # reject a bad suffix before any work is done
+    s = load_scenario_warn(scenario)
+    if planner is PlannerName.fuzzy_rrt:
+        from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
+
+        rulebook = rulebook if rulebook is not None else default_rulebook_path()
+        rulebook_obj = load_rulebook(rulebook)
+    else:
+        rulebook_obj = None
+    result = plan_scenario(
+        s, planner=planner.value, rulebook=rulebook_obj, seed=seed, max_iter=max_iter,
+        step_deg=step_deg, goal_bias=goal_bias, trace=trace is not None,
+    )
+    if trace is not None:
+        from xfuzzy_rrt.planners.api import write_trace
+
+        write_trace(result, trace)
+    data = result.to_json_dict()
+    # Where the inputs came from, so that 'xfuzzy-rrt explain RESULT.json' can replay the run.
+    data["scenario_file"] = str(scenario.resolve())
+    data["rulebook_dir"] = str(rulebook.resolve()) if rulebook_obj is not None else None
+    emit_json(data, out)
+    return 0 if result.success else 1
+
+
+def register(app: typer.Typer) -> None:
+    app.command("plan")(plan)

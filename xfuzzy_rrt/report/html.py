@@ -1,0 +1,168 @@
+"""Page assembly for the HTML audit reports: offline, escaped, deterministic.
+
+Why these rules (DESIGN.md, "Reports"):
+
+- *Offline*: an audit report must open years later on an air-gapped machine, so plotly.js is
+  embedded once in the page head and every figure is written with ``include_plotlyjs=False``;
+  no ``<script src=...>`` and no CDN.
+- *Escaped*: scenario names, descriptions, commands and paths come from user files; every piece
+  of text goes through :func:`esc` before it reaches the page (figure titles too, since plotly
+  renders a subset of HTML in them).
+- *Deterministic*: every figure gets an explicit ``div_id`` (plotly would otherwise draw a
+  random UUID), so two reports of the same inputs differ only in the date line and can be
+  diffed.
+
+The training and trace reports reuse :class:`Page`, :func:`figure_div` and :func:`table`.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+import re
+from typing import Any, Callable, Iterable, Sequence
+
+import numpy as np
+
+#: Small stylesheet shared by all reports (print-friendly, no external fonts).
+CSS = """
+body { font-family: -apple-system, "Segoe UI", Roboto, Helvetica, Arial, sans-serif;
+       color: #222; margin: 0 auto; max-width: 1400px; padding: 16px 24px; line-height: 1.45; }
+h1 { font-size: 1.6em; margin-bottom: 0.2em; }
+h2 { font-size: 1.3em; border-bottom: 1px solid #ccc; padding-bottom: 4px; margin-top: 1.8em; }
+h3 { font-size: 1.1em; margin-top: 1.2em; }
+code, pre { font-family: Menlo, Consolas, "DejaVu Sans Mono", monospace; font-size: 0.92em; }
+pre { background: #f5f5f5; padding: 8px 10px; overflow-x: auto; white-space: pre-wrap;
+      word-break: break-all; }
+table.data { border-collapse: collapse; margin: 8px 0 12px 0; font-size: 0.92em; }
+table.data th, table.data td { border: 1px solid #ccc; padding: 3px 8px; }
+table.data th { background: #f0f0f0; text-align: center; }
+table.data td.num { text-align: right; font-variant-numeric: tabular-nums; }
+table.data td.txt { text-align: left; }
+table.kv td:first-child { font-weight: 600; background: #fafafa; white-space: nowrap; }
+table.kv td { word-break: break-all; }
+.note { color: #444; font-size: 0.95em; max-width: 70em; }
+.muted { color: #777; }
+.grid { display: grid; gap: 12px; }
+.cell { min-width: 0; border: 1px solid #eee; padding: 4px; }
+.fig { width: 100%; }
+details > summary { cursor: pointer; color: #0550ae; }
+"""
+
+#: Sets plotly's global config before plotly.js loads (as plotly's own full-page output does):
+#: MathJax 'local' so plotly never tries to fetch MathJax from the network.
+_PLOTLY_CONFIG = "window.PlotlyConfig = {MathJaxConfig: 'local'};"
+
+
+def esc(value: Any) -> str:
+    """HTML-escape ``str(value)`` (quotes included); ``None`` becomes an empty string."""
+    return "" if value is None else html.escape(str(value), quote=True)
+
+
+def slug(text: str) -> str:
+    """A lowercase ``[a-z0-9-]`` identifier fragment (for div ids and anchors)."""
+    s = re.sub(r"[^a-z0-9]+", "-", str(text).lower()).strip("-")
+    return s or "x"
+
+
+def fmt_num(value: Any, digits: int = 1) -> str:
+    """Format a number for a table: integers without decimals, others with ``digits``.
+
+    A median of integer counts is an integer or ends in ``.5``, so ``fmt_num(142.0) == '142'``
+    and ``fmt_num(142.5) == '142.5'``. NaN/None render as an em dash.
+    """
+    if value is None:
+        return "\u2014"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        return str(value)
+    if math.isnan(x):
+        return "\u2014"
+    if math.isinf(x):
+        return "\u221e" if x > 0 else "-\u221e"
+    if x.is_integer() and abs(x) < 1e15:
+        return str(int(x))
+    return f"{x:.{digits}f}"
+
+
+def figure_div(fig, div_id: str, height: int | None = None) -> str:
+    """A plotly figure as an HTML fragment without plotly.js, with a fixed ``div_id``."""
+    if height is not None:
+        fig.update_layout(height=height)
+    body = fig.to_html(full_html=False, include_plotlyjs=False, div_id=div_id,
+                       config={"displaylogo": False, "responsive": True},
+                       default_height=f"{fig.layout.height or 450}px")
+    return f'<div class="fig">{body}</div>'
+
+
+def table(rows: Iterable[Sequence[Any]], header: Sequence[str] | None,
+          formats: Sequence[Callable[[Any], str] | None] | None = None,
+          css_class: str = "data", raw_html: bool = False) -> str:
+    """An HTML table. ``formats[i]`` formats column *i* (``None``: :func:`fmt_num` for numbers).
+
+    Cells are escaped unless ``raw_html`` (for callers that build escaped markup themselves).
+    Numbers are right-aligned. ``header=None`` omits the header row.
+    """
+    out = [f'<table class="{esc(css_class)}">']
+    if header is not None:
+        out.append("<thead><tr>")
+        out += [f"<th>{esc(h)}</th>" for h in header]
+        out.append("</tr></thead>")
+    out.append("<tbody>")
+    for row in rows:
+        out.append("<tr>")
+        for i, v in enumerate(row):
+            f = formats[i] if formats is not None and i < len(formats) else None
+            numeric = isinstance(v, (int, float, np.number)) and not isinstance(v, (bool, np.bool_))
+            text = f(v) if f is not None else (fmt_num(v) if numeric else str(v))
+            cls = "num" if numeric else "txt"
+            out.append(f'<td class="{cls}">{text if raw_html else esc(text)}</td>')
+        out.append("</tr>")
+    out.append("</tbody></table>")
+    return "".join(out)
+
+
+def kv_table(pairs: Iterable[tuple[str, Any]]) -> str:
+    """A two-column key/value table (keys and values escaped)."""
+    return table(((k, "\u2014" if v is None else str(v)) for k, v in pairs), None,
+                 css_class="data kv")
+
+
+class Page:
+    """Collects HTML fragments and renders one self-contained page.
+
+    Fragments passed to :meth:`add` must already be escaped (use :func:`esc`); :meth:`heading`
+    and :meth:`paragraph` escape for you.
+    """
+
+    def __init__(self, title: str) -> None:
+        self.title = title
+        self.parts: list[str] = []
+
+    def add(self, fragment: str) -> None:
+        self.parts.append(fragment)
+
+    def heading(self, text: str, level: int = 2, anchor: str | None = None) -> None:
+        ident = f' id="{esc(anchor)}"' if anchor else ""
+        self.parts.append(f"<h{level}{ident}>{esc(text)}</h{level}>")
+
+    def paragraph(self, text: str, css_class: str = "note") -> None:
+        self.parts.append(f'<p class="{esc(css_class)}">{esc(text)}</p>')
+
+    def render(self) -> str:
+        """The page, with plotly.js embedded exactly once in the head."""
+        from plotly.offline import get_plotlyjs
+
+        return "".join([
+            "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n",
+            f"<title>{esc(self.title)}</title>\n",
+            f"<style>{CSS}</style>\n",
+            f"<script>{_PLOTLY_CONFIG}</script>\n",
+            '<script type="text/javascript">', get_plotlyjs(), "</script>\n",
+            "</head>\n<body>\n",
+            "\n".join(self.parts),
+            "\n</body>\n</html>\n",
+        ])

@@ -38,7 +38,6 @@ Choices where the paper is silent or ambiguous (and why):
 
 from __future__ import annotations
 
-import math
 import time
 
 import numba as nb
@@ -48,22 +47,13 @@ from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_OUTPUTS
 from xfuzzy_rrt.geometry.collision import (
     CERT_MARGIN_M,
-    config_free,
     direction_and_distance,
-    edge_free,
     nearest_obstacle_from_point,
 )
 from xfuzzy_rrt.geometry.kinematics import end_effector
 from xfuzzy_rrt.geometry.scenario import Scenario
-from xfuzzy_rrt.planners.result import (
-    ACCEPTED,
-    EDGE_BLOCKED,
-    GOAL_REACHED,
-    NO_PROGRESS,
-    NODE_IN_COLLISION,
-    PlanResult,
-    path_cost_deg,
-)
+from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.rrt import check_planar_2dof
 from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path, nearest
@@ -156,43 +146,10 @@ def fuzzy_rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, 
         # 5. Nearest node (carried to the next iteration) and steering.
         from_node = current
         current = nearest(nodes, cell_next, cell_head, meta, grid, sx, sy)
-        q_near[0] = nodes[current, 0]
-        q_near[1] = nodes[current, 1]
-        dx = sx - q_near[0]
-        dy = sy - q_near[1]
-        d = math.sqrt(dx * dx + dy * dy)
-        outcome = ACCEPTED
-        new_index = -1
-        if d == 0.0:
-            outcome = NO_PROGRESS
-            q_new[0] = q_near[0]
-            q_new[1] = q_near[1]
-        else:
-            if d <= step:
-                q_new[0] = sx
-                q_new[1] = sy
-            else:
-                q_new[0] = q_near[0] + dx * (step / d)
-                q_new[1] = q_near[1] + dy * (step / d)
-            # 6. Certified checks.
-            if not config_free(links, base, radius, obstacles, limits, q_new, margin):
-                outcome = NODE_IN_COLLISION
-            elif not edge_free(links, base, radius, obstacles, q_near, q_new, margin):
-                outcome = EDGE_BLOCKED
-            else:
-                # 7. Grow, then try the goal.
-                new_index = add_node(nodes, parent, cell_next, cell_head, meta, grid,
-                                     q_new[0], q_new[1], current)
-                if q_new[0] == goal[0] and q_new[1] == goal[1]:
-                    outcome = GOAL_REACHED
-                else:
-                    gdx = goal[0] - q_new[0]
-                    gdy = goal[1] - q_new[1]
-                    if math.sqrt(gdx * gdx + gdy * gdy) <= step and edge_free(
-                            links, base, radius, obstacles, q_new, goal, margin):
-                        new_index = add_node(nodes, parent, cell_next, cell_head, meta, grid,
-                                             goal[0], goal[1], new_index)
-                        outcome = GOAL_REACHED
+        # 6-7. Steer, certify, grow, try the goal (shared with RRT).
+        outcome, new_index = extend(links, base, radius, obstacles, limits, goal, margin,
+                                    nodes, parent, cell_next, cell_head, meta, grid, current,
+                                    sx, sy, step, q_near, q_new)
         if record:
             tr_from[row] = from_node
             tr_x[row, 0] = x[0]

@@ -18,9 +18,10 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, config_free, edge_free
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
 from xfuzzy_rrt.geometry.scenario import Scenario
-from xfuzzy_rrt.planners.result import PlanResult, path_cost_deg
+from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path, nearest
 
@@ -46,32 +47,10 @@ def rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, max_it
             sx = limits[0, 0] + uniform(state) * (limits[0, 1] - limits[0, 0])
             sy = limits[1, 0] + uniform(state) * (limits[1, 1] - limits[1, 0])
         ni = nearest(nodes, cell_next, cell_head, meta, grid, sx, sy)
-        q_near[0] = nodes[ni, 0]
-        q_near[1] = nodes[ni, 1]
-        dx = sx - q_near[0]
-        dy = sy - q_near[1]
-        d = math.sqrt(dx * dx + dy * dy)
-        if d == 0.0:
-            continue
-        if d <= step:
-            q_new[0] = sx
-            q_new[1] = sy
-        else:
-            q_new[0] = q_near[0] + dx * (step / d)
-            q_new[1] = q_near[1] + dy * (step / d)
-        if not config_free(links, base, radius, obstacles, limits, q_new, margin):
-            continue
-        if not edge_free(links, base, radius, obstacles, q_near, q_new, margin):
-            continue
-        k = add_node(nodes, parent, cell_next, cell_head, meta, grid, q_new[0], q_new[1], ni)
-        if q_new[0] == goal[0] and q_new[1] == goal[1]:
+        outcome, k = extend(links, base, radius, obstacles, limits, goal, margin, nodes, parent,
+                            cell_next, cell_head, meta, grid, ni, sx, sy, step, q_near, q_new)
+        if outcome == GOAL_REACHED:
             return True, it, k
-        gx = goal[0] - q_new[0]
-        gy = goal[1] - q_new[1]
-        if math.sqrt(gx * gx + gy * gy) <= step:
-            if edge_free(links, base, radius, obstacles, q_new, goal, margin):
-                g = add_node(nodes, parent, cell_next, cell_head, meta, grid, goal[0], goal[1], k)
-                return True, it, g
     return False, max_iter, -1
 
 

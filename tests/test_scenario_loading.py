@@ -88,6 +88,8 @@ def test_missing_scenario_file_is_one_line(run_cli, tmp_path):
     (["--planner", "astar"], "--planner"),
     (["--seed", "abc"], "--seed"),
     (["--max-iter", "0"], "--max-iter"),
+    (["--max-iter", "10000000000000"], "--max-iter"),
+    (["--rulebook", "."], "not a rulebook directory"),
     (["--trace", "t.txt", "--planner", "fuzzy-rrt"], "t.txt"),
 ])
 def test_bad_cli_arguments_give_one_line_exit_2(run_cli, tmp_path, args, fragment):

@@ -62,7 +62,7 @@ def bench(
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),
     seed: int = typer.Option(0, "--seed", help="First seed; run k uses seed + k."),
     rulebook: Optional[Path] = typer.Option(None, "--rulebook", help="Rulebook directory."),
-    max_iter: int = typer.Option(10_000, "--max-iter", min=1, help="Iteration budget per run."),
+    max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Output folder (default reports/bench-<time>)."),
     workers: int = typer.Option(1, "--workers", min=1, help="Worker processes."),
 ) -> int:

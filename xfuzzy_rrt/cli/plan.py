@@ -20,7 +20,7 @@ def plan(
     rulebook: Optional[Path] = typer.Option(
         None, "--rulebook", help="Rulebook directory (fuzzy-rrt; default: the shipped default)."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
-    max_iter: int = typer.Option(10_000, "--max-iter", min=1, help="Iteration budget."),
+    max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON here (default: stdout)."),
     trace: Optional[Path] = typer.Option(
         None, "--trace", help="Write the per-iteration trace (.parquet or .csv; fuzzy-rrt)."),

@@ -250,6 +250,11 @@ def load_rulebook(path: str | os.PathLike[str]) -> Rulebook:
     if not root.is_dir():
         raise RulebookError([(str(root), None, "not a directory (a rulebook is a directory)")])
     problems: list[tuple[str, int | None, str]] = []
+    expected = [MANIFEST_NAME, *(fis_file_name(o) for o in OUTPUTS)]
+    if not any((root / name).exists() for name in expected):
+        # Not a damaged rulebook but no rulebook at all: one line, not seven "missing file"s.
+        raise RulebookError([(str(root), None, f"not a rulebook directory (no {MANIFEST_NAME} "
+                              f"and no {SUFFIX} files)")])
     try:
         extra = sorted(
             p.name for p in root.iterdir()

@@ -55,7 +55,7 @@ from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.extend import extend
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
-from xfuzzy_rrt.planners.rrt import check_planar_2dof
+from xfuzzy_rrt.planners.checks import check_max_iter, check_planar_2dof
 from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path, nearest
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
@@ -220,11 +220,8 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     or ``None`` for the shipped default. With ``trace=True`` the result carries a per-iteration
     DataFrame (see :mod:`xfuzzy_rrt.planners.trace`). Same inputs and seed, same result.
     """
-    from xfuzzy_rrt.errors import InputError
-
     check_planar_2dof(scenario)
-    if int(max_iter) < 1:
-        raise InputError("max_iter", f"must be >= 1, got {max_iter!r}")
+    check_max_iter(max_iter)
     rb = _resolve_rulebook(rulebook)
     knots, consts = rb.arrays()
     mode = BOUNDS_RELATIVE if rb.bounds_mode == "relative" else BOUNDS_ABSOLUTE

@@ -11,7 +11,6 @@ Fuzzy-RRT: every sample counts, accepted or not.
 
 from __future__ import annotations
 
-import math
 import time
 
 import numba as nb
@@ -20,6 +19,7 @@ import numpy as np
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
 from xfuzzy_rrt.geometry.scenario import Scenario
+from xfuzzy_rrt.planners.checks import check_max_iter, check_planar_2dof, check_positive
 from xfuzzy_rrt.planners.extend import extend
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
@@ -54,17 +54,6 @@ def rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, max_it
     return False, max_iter, -1
 
 
-def check_planar_2dof(scenario: Scenario) -> None:
-    if scenario.arm.dof != 2:
-        raise InputError(scenario.source or scenario.name,
-                         f"arm.links: the planners handle 2-DOF arms, this arm has {scenario.arm.dof}")
-
-
-def check_positive(name: str, value: float) -> None:
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-        raise InputError(name, f"must be a positive number, got {value!r}")
-
-
 def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER,
              step_deg: float = DEFAULT_STEP_DEG, goal_bias: float = DEFAULT_GOAL_BIAS,
              margin: float = CERT_MARGIN_M) -> PlanResult:
@@ -73,8 +62,7 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
     check_positive("step_deg", step_deg)
     if not 0.0 <= goal_bias <= 1.0:
         raise InputError("goal_bias", f"must lie in [0, 1], got {goal_bias!r}")
-    if int(max_iter) < 1:
-        raise InputError("max_iter", f"must be >= 1, got {max_iter!r}")
+    check_max_iter(max_iter)
     a = scenario.arrays()
     tree = Tree(int(max_iter) + 2, a.limits_deg)
     t0 = time.perf_counter()

@@ -117,6 +117,17 @@ def segment_obstacle_dist(ax, ay, bx, by, ob):
     return d
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def _link_clearance(ax, ay, bx, by, radius, obstacles):
+    """Clearance of one link capsule (segment AB dilated by ``radius``) to all obstacles."""
+    best = np.inf
+    for o in range(obstacles.shape[0]):
+        d = segment_obstacle_dist(ax, ay, bx, by, obstacles[o]) - radius
+        if d < best:
+            best = d
+    return best
+
+
 @nb.njit(cache=True, nogil=True)
 def clearance_kernel(links, base, radius, obstacles, q_deg):
     """Smallest distance between any link capsule and any obstacle (<= 0: collision).
@@ -131,10 +142,7 @@ def clearance_kernel(links, base, radius, obstacles, q_deg):
         theta += math.radians(q_deg[k])
         nx = x + links[k] * math.cos(theta)
         ny = y + links[k] * math.sin(theta)
-        for o in range(obstacles.shape[0]):
-            d = segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - radius
-            if d < best:
-                best = d
+        best = min(best, _link_clearance(x, y, nx, ny, radius, obstacles))
         x = nx
         y = ny
     return best
@@ -182,11 +190,7 @@ def edge_free(links, base, radius, obstacles, qa_deg, qb_deg, margin):
             theta += math.radians(qk)
             nx = x + links[k] * math.cos(theta)
             ny = y + links[k] * math.sin(theta)
-            ck = np.inf
-            for o in range(obstacles.shape[0]):
-                d = segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - radius
-                if d < ck:
-                    ck = d
+            ck = _link_clearance(x, y, nx, ny, radius, obstacles)
             x = nx
             y = ny
             if ck < cmin:

@@ -206,3 +206,17 @@ def test_benchmark_results_do_not_depend_on_the_number_of_workers():
     two = run_benchmark([s], ["rrt", "fuzzy-rrt"], runs=6, workers=2)
     cols = [c for c in one.runs.columns if c != "wall_s"]
     assert one.runs[cols].to_csv(index=False) == two.runs[cols].to_csv(index=False)
+
+
+def test_report_names_the_rules_that_drove_the_fuzzy_example_run():
+    from xfuzzy_rrt.bench.runner import run_benchmark
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.report.bench_report import render_bench_report
+
+    s = load_scenario(TWO_CIRCLES)
+    result = run_benchmark([s], ["rrt", "fuzzy-rrt"], runs=3)
+    example = result.examples[(s.name, "fuzzy-rrt")]
+    assert example.trace is not None and len(example.trace) == example.iterations
+    html = render_bench_report(result, command="xfuzzy-rrt bench", generated_at="T")
+    assert "Rules that drove the example Fuzzy-RRT run" in html
+    assert html.count("if angle_to_goal is ") >= 6 * 3

@@ -23,6 +23,7 @@ import pandas as pd
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.membership import partition
+from xfuzzy_rrt.fuzzy.text_format import rule_sentence
 from xfuzzy_rrt.fuzzy.variables import INPUTS, MAX_FIRED, OUTPUTS, rule_terms
 
 
@@ -137,9 +138,7 @@ def explain_row(row: pd.Series, rulebook) -> Explanation:
         total = sum(w for _, w in raw)
         rules = []
         for r, w in raw:
-            t = rule_terms(r)
-            words = " and ".join(f"{inp.name} is {inp.terms[t[i]]}" for i, inp in enumerate(fis.inputs))
-            rules.append(FiredRule(index=r, sentence=f"if {words} then {output} = {fis.consts[r]!r}",
+            rules.append(FiredRule(index=r, sentence=rule_sentence(fis, r),
                                    constant=fis.consts[r], strength=w / total,
                                    traced_strength=traced.get(r, float("nan"))))
         value = sum(rr.contribution for rr in rules)

@@ -37,6 +37,8 @@ class BenchResult:
     examples: dict[tuple[str, str], PlanResult] = field(default_factory=dict)
     scenarios: dict[str, Scenario] = field(default_factory=dict)
     settings: dict[str, Any] = field(default_factory=dict)
+    #: The loaded rulebook Fuzzy-RRT used (``None`` without fuzzy-rrt), for rule sentences.
+    rulebook: Any = None
 
 
 def _one_run(args) -> PlanResult:
@@ -110,6 +112,7 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
                 break
     return BenchResult(runs=runs_df, summary=summary, examples=examples,
                        scenarios={s.name: s for s in scenarios},
+                       rulebook=rulebook if "fuzzy-rrt" in planners else None,
                        settings={"runs": runs, "seed": seed, "max_iter": max_iter,
                                  "planners": list(planners),
                                  "rulebook": getattr(rulebook, "name", None),

@@ -124,6 +124,13 @@ def header_comment(output: str) -> list[str]:
     ]
 
 
+def rule_sentence(fis: FuzzySystem, r: int) -> str:
+    """Rule *r* of *fis* as the sentence the text format writes (without the ``rN:`` label)."""
+    t = rule_terms(r)
+    ante = " and ".join(f"{inp.name} is {inp.terms[t[i]]}" for i, inp in enumerate(fis.inputs))
+    return f"if {ante} then {fis.output} = {fnum(fis.consts[r])}"
+
+
 def format_fis(fis: FuzzySystem) -> str:
     """The canonical text of *fis* (``\\n`` line ends, trailing newline)."""
     lo, hi = fis.range
@@ -139,13 +146,12 @@ def format_fis(fis: FuzzySystem) -> str:
     names = [inp.name for inp in fis.inputs]
     terms = [inp.terms for inp in fis.inputs]
     block = N_TERMS * N_TERMS
-    for r, c in enumerate(fis.consts):
+    for r in range(len(fis.consts)):
         t = rule_terms(r)
         if r % block == 0:
             lines.append("")
             lines.append(f"# {names[0]} is {terms[0][t[0]]}, {names[1]} is {terms[1][t[1]]}")
-        ante = " and ".join(f"{names[i]} is {terms[i][t[i]]}" for i in range(len(names)))
-        lines.append(f"r{r}: if {ante} then {fis.output} = {fnum(c)}")
+        lines.append(f"r{r}: {rule_sentence(fis, r)}")
     lines.append("end")
     return "\n".join(lines) + "\n"
 

@@ -301,6 +301,28 @@ def _scenario_section(page: Page, idx: int, name: str, result, planners: list[st
                             title=f"{F.plot_text(name)}: outcome of each iteration (example runs)")
     if ofig is not None:
         page.add(f'<div style="max-width: 760px;">{figure_div(ofig, f"fig-s{idx}-outcomes")}</div>')
+    fuzzy = examples.get("fuzzy-rrt")
+    if fuzzy is not None and getattr(fuzzy, "trace", None) is not None and result.rulebook is not None:
+        page.add(_influence_table(fuzzy, result.rulebook))
+
+
+def _influence_table(run, rulebook, k: int = 3) -> str:
+    """The rules that drove the example Fuzzy-RRT run: top ``k`` per output by influence."""
+    from xfuzzy_rrt.analysis.firing import top_rules
+    from xfuzzy_rrt.fuzzy.text_format import rule_sentence
+    from xfuzzy_rrt.fuzzy.variables import OUTPUTS
+
+    top = top_rules(run.trace, k=k)
+    rows = []
+    for _, row in top.iterrows():
+        fis = rulebook.systems[OUTPUTS.index(row["output"])]
+        rows.append((row["output"], f"r{int(row['rule'])}", rule_sentence(fis, int(row["rule"])),
+                     f"{100 * row['share']:.1f}%", int(row["iterations_fired"])))
+    intro = (f"<p>Rules that drove the example Fuzzy-RRT run (seed {int(run.seed)}, "
+             f"{int(run.iterations)} iterations): for each output, the {k} rules with the largest "
+             "share of the summed normalised firing strength over all iterations. Use "
+             "<code>xfuzzy-rrt explain</code> on a trace to see single expansions.</p>")
+    return intro + table(rows, ["output", "rule", "sentence", "share", "iterations fired"])
 
 
 def _runs_details(runs: pd.DataFrame) -> str:

@@ -93,35 +93,30 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
     } for r in results]
     runs_df = pd.DataFrame(rows, columns=RUN_COLUMNS)
     summary = summarise(runs_df)
+    by_name = {s.name: s for s in scenarios}
+    by_run = {(r.scenario, r.planner, r.seed): r for r in results}
     examples = {}
     for (scen, planner), group in runs_df.groupby(["scenario", "planner"], sort=False):
         ok = group[group["success"]]
         if ok.empty:
             continue
         target = ok["iterations"].median()
-        pick = ok.iloc[int(np.argmin(np.abs(ok["iterations"].to_numpy() - target)))]
-        for r in results:
-            if (r.scenario, r.planner, r.seed) == (scen, planner, pick["seed"]):
-                if planner == "fuzzy-rrt":
-                    # Re-run the example with tracing (deterministic: same run, plus its trace)
-                    # so the report can show what the fuzzy systems decided.
-                    r = plan_scenario(r_scenario(scenarios, scen), planner=planner,
-                                      rulebook=rulebook, seed=r.seed, max_iter=max_iter,
-                                      trace=True)
-                examples[(scen, planner)] = r
-                break
+        seed_ = int(ok["seed"].iloc[int(np.argmin(np.abs(ok["iterations"].to_numpy() - target)))])
+        example = by_run[(scen, planner, seed_)]
+        if planner == "fuzzy-rrt":
+            # Re-run the example with tracing (deterministic: the same run, plus its trace)
+            # so the report can show what the fuzzy systems decided.
+            example = plan_scenario(by_name[scen], planner=planner, rulebook=rulebook,
+                                    seed=seed_, max_iter=max_iter, trace=True)
+        examples[(scen, planner)] = example
     return BenchResult(runs=runs_df, summary=summary, examples=examples,
-                       scenarios={s.name: s for s in scenarios},
+                       scenarios=by_name,
                        rulebook=rulebook if "fuzzy-rrt" in planners else None,
                        settings={"runs": runs, "seed": seed, "max_iter": max_iter,
                                  "planners": list(planners),
                                  "rulebook": getattr(rulebook, "name", None),
                                  "rulebook_dir": rulebook_dir,
                                  "rulebook_sha256": getattr(rulebook, "sha256", None)})
-
-
-def r_scenario(scenarios: list[Scenario], name: str) -> Scenario:
-    return next(s for s in scenarios if s.name == name)
 
 
 def summarise(runs: pd.DataFrame) -> pd.DataFrame:

@@ -38,6 +38,7 @@ Choices where the paper is silent or ambiguous (and why):
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numba as nb
@@ -251,11 +252,5 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
 
         frame = trace_frame(buffers, int(iterations), tree.nodes[:n], tree.parent[:n], last, rb,
                             float(min_step_deg))
-        result = _with_trace(result, frame)
+        result = dataclasses.replace(result, trace=frame)
     return result
-
-
-def _with_trace(result: PlanResult, frame) -> PlanResult:
-    from dataclasses import replace
-
-    return replace(result, trace=frame)

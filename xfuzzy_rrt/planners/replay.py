@@ -12,12 +12,7 @@ import json
 from pathlib import Path
 
 from xfuzzy_rrt.errors import InputError
-
-
-def _load_rulebook(path):
-    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
-
-    return load_rulebook(path)
+from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
 
 
 def trace_for(source: Path, rulebook: Path | None = None):
@@ -30,15 +25,13 @@ def trace_for(source: Path, rulebook: Path | None = None):
     frame = load_trace(source)
     if rulebook is None:
         # The trace names its rulebook; look for a shipped one of that name.
-        from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
-
         name = str(frame["rulebook"].iloc[0]) if "rulebook" in frame and len(frame) else ""
         candidate = rulebooks_dir() / name
         if not name or not candidate.is_dir():
             raise InputError("--rulebook", f"the trace was made with rulebook {name!r}, which is not "
                              "shipped; pass its directory with --rulebook")
         rulebook = candidate
-    return frame, _load_rulebook(rulebook)
+    return frame, load_rulebook(rulebook)
 
 
 def _replay_result(path: Path, rulebook: Path | None):
@@ -59,7 +52,7 @@ def _replay_result(path: Path, rulebook: Path | None):
                              "that records it, or pass a trace file")
     scenario = load_scenario(data["scenario_file"])
     rulebook_dir = rulebook if rulebook is not None else data["rulebook_dir"]
-    rb = _load_rulebook(rulebook_dir)
+    rb = load_rulebook(rulebook_dir)
     if rb.sha256 != data["rulebook_sha256"]:
         raise InputError(str(path), f"rulebook_sha256: the rulebook at {rulebook_dir} is not the "
                          "one that made this result (it was edited or replaced)")

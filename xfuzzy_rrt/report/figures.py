@@ -153,6 +153,14 @@ def run_caption(result) -> str:
             f" \u00b7 cost {cost}")
 
 
+def _default_title(scenario: Scenario, result, view: str) -> str:
+    """``<scenario> — <view>``, or ``<planner>: <view>`` with the run caption for a result."""
+    if result is None:
+        return f"{plot_text(scenario.name)} \u2014 {view}"
+    return (f"{plot_text(planner_label(result.planner))}: {view}<br>"
+            f"<sup>{plot_text(run_caption(result))}</sup>")
+
+
 def joint_space_figure(scenario: Scenario, result=None, grid: CSpaceGrid | None = None,
                        title: str | None = None, show_tree: bool = True) -> go.Figure:
     """C-obstacle map, the planner's tree (light), its path (bold), start and goal, in degrees.
@@ -192,10 +200,7 @@ def joint_space_figure(scenario: Scenario, result=None, grid: CSpaceGrid | None 
                                          line=dict(color="white", width=1)),
                              hovertemplate="goal (%{x:.1f}\u00b0, %{y:.1f}\u00b0)<extra></extra>"))
     if title is None:
-        title = f"{plot_text(scenario.name)} \u2014 joint space"
-        if result is not None:
-            title = (f"{plot_text(planner_label(result.planner))}: joint space<br>"
-                     f"<sup>{plot_text(run_caption(result))}</sup>")
+        title = _default_title(scenario, result, "joint space")
     fig.update_layout(
         template=TEMPLATE, title=dict(text=title, x=0.5, xanchor="center"),
         margin=dict(l=55, r=15, t=70, b=50),
@@ -328,10 +333,7 @@ def workspace_figure(scenario: Scenario, result=None, n_poses: int = 5,
                              marker=dict(symbol="square", size=11, color="#222222"),
                              hovertemplate="base<extra></extra>"))
     if title is None:
-        title = f"{plot_text(scenario.name)} \u2014 workspace"
-        if result is not None:
-            title = (f"{plot_text(planner_label(result.planner))}: workspace<br>"
-                     f"<sup>{plot_text(run_caption(result))}</sup>")
+        title = _default_title(scenario, result, "workspace")
     xr, yr = workspace_bounds(scenario)
     fig.update_layout(
         template=TEMPLATE, shapes=shapes, title=dict(text=title, x=0.5, xanchor="center"),

@@ -1,0 +1,117 @@
+"""``xfuzzy-rrt train``: genetic training of a rulebook (parses options, renders progress)."""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+
+
+class _Progress:
+    """One line per generation; on a terminal also a live bar while a generation runs."""
+
+    def __init__(self, generations: int, stream=None):
+        self.stream = stream or sys.stderr
+        self.tty = self.stream.isatty()
+        self.generations = generations
+        self.started = time.perf_counter()
+        self.done_here = 0  # generations run in this process (for the ETA)
+        self.gen = 0
+
+    def start(self, engine: str, generation: int) -> None:
+        self.gen = generation
+        where = f"resuming after generation {generation}" if generation else "starting"
+        self._line(f"training on {engine}: {where}, up to {self.generations} generations")
+
+    def chunk(self, done: int, total: int) -> None:
+        if self.tty:
+            width = 30
+            fill = int(width * done / total)
+            self.stream.write(f"\r  generation {self.gen + 1}: [{'#' * fill}{'.' * (width - fill)}] "
+                              f"{done}/{total} chunks")
+            self.stream.flush()
+
+    def generation(self, row: dict) -> None:
+        self.gen = int(row["generation"])
+        self.done_here += 1
+        elapsed = time.perf_counter() - self.started
+        left = self.generations - self.gen
+        eta = elapsed / self.done_here * left
+        self._line(
+            f"gen {self.gen:>3}/{self.generations}  best {row['best_fitness']:9.1f}  "
+            f"mean {row['mean_fitness']:9.1f}  median {row['median_fitness']:9.1f}  "
+            f"best median iterations {row['best_median_iterations']:7.1f}  "
+            f"{row['runs_per_s']:8.0f} runs/s  {row['wall_s']:6.2f} s  ETA <= {eta:5.0f} s")
+
+    def phase(self, text: str) -> None:
+        self._line(text)
+
+    def _line(self, text: str) -> None:
+        if self.tty:
+            self.stream.write("\r\033[K")
+        self.stream.write(text + "\n")
+        self.stream.flush()
+
+
+def train(
+    scenario: List[Path] = typer.Option(..., "--scenario", help="Training scenario file or directory (repeatable)."),
+    population: int = typer.Option(400, "--population", help="Individuals per generation (paper: 400)."),
+    generations: int = typer.Option(50, "--generations", help="Maximum generations (paper: 50)."),
+    runs_per_eval: int = typer.Option(5, "--runs-per-eval", help="Planner runs per scenario per individual (paper: 5)."),
+    target_fitness: float = typer.Option(9750.0, "--target-fitness", help="Stop when the best fitness reaches this (paper: 9750)."),
+    seed: int = typer.Option(0, "--seed", help="Seed: the result depends only on it and the inputs."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: all cores; 1 = in-process)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address (tcp://HOST:PORT): evaluate there."),
+    out: Path = typer.Option(..., "--out", help="Rulebook directory to write (also history.csv and checkpoint/)."),
+    resume: bool = typer.Option(False, "--resume", help="Continue from OUT/checkpoint after an interruption."),
+    bounds: str = typer.Option("absolute", "--bounds", help="How bound outputs are meant: absolute (paper) or relative."),
+    max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run (reward = max_iter - iterations)."),
+    elite: int = typer.Option(8, "--elite", help="Best individuals copied unchanged into the next generation."),
+    tournament: int = typer.Option(3, "--tournament", help="Tournament size of the selection."),
+    crossover_prob: float = typer.Option(0.9, "--crossover-prob", help="Probability that a mating crosses (SBX)."),
+    crossover_eta: float = typer.Option(15.0, "--crossover-eta", help="SBX distribution index."),
+    mutation_rate: float = typer.Option(0.01, "--mutation-rate", help="Per-gene polynomial mutation probability."),
+    mutation_eta: float = typer.Option(20.0, "--mutation-eta", help="Polynomial mutation distribution index."),
+    block_rate: float = typer.Option(0.5, "--block-rate", help="Per-child probability of a term-block mutation."),
+    block_sigma: float = typer.Option(0.05, "--block-sigma", help="Scale of term-block mutations (genes are in [0, 1])."),
+    init: str = typer.Option("seeded", "--init", help="First generation: seeded (known rulebooks + perturbations) or random."),
+    validation_runs: int = typer.Option(50, "--validation-runs", help="Runs per scenario to choose the final rulebook."),
+    name: Optional[str] = typer.Option(None, "--name", help="Rulebook name (default: the --out folder's name)."),
+) -> int:
+    """Train the six fuzzy systems with the paper's genetic algorithm; write a rulebook."""
+    from xfuzzy_rrt.training.ga import GAConfig
+    from xfuzzy_rrt.training.run import TrainJob, load_training_scenarios, run_training
+
+    scenarios = load_training_scenarios(scenario)
+    config = GAConfig(
+        population=population, generations=generations, runs_per_eval=runs_per_eval,
+        target_fitness=target_fitness, seed=seed, bounds=bounds, max_iter=max_iter, elite=elite,
+        tournament=tournament, crossover_prob=crossover_prob, crossover_eta=crossover_eta,
+        mutation_rate=mutation_rate, mutation_eta=mutation_eta, block_rate=block_rate,
+        block_sigma=block_sigma, init=init, validation_runs=validation_runs,
+        scenarios=tuple((t.scenario.name, t.sha256) for t in scenarios),
+    )
+    job = TrainJob(config=config, scenarios=scenarios, out=out, resume=resume, workers=workers,
+                   scheduler=scheduler, name=name)
+    progress = _Progress(generations)
+    try:
+        result = run_training(job, on_start=progress.start, on_generation=progress.generation,
+                              on_chunk=progress.chunk, on_phase=progress.phase)
+    except KeyboardInterrupt:
+        progress.phase(f"interrupted; the last complete generation is checkpointed: "
+                       f"continue with the same command plus --resume")
+        raise
+    h = result.state.history
+    typer.echo(f"generations run: {len(h)}; final best fitness {h[-1]['best_fitness']:.1f}; "
+               f"chosen: {result.chosen_from}; validation fitness {result.validation_fitness:.1f}, "
+               f"median iterations {result.validation_iterations_median:g}, "
+               f"success {100 * result.validation_success_rate:.0f} %")
+    typer.echo(f"wrote {out}/ (rulebook), {out / 'history.csv'}, {out / 'checkpoint'}/")
+    return 0
+
+
+def register(app: typer.Typer) -> None:
+    app.command("train")(train)

@@ -1,0 +1,370 @@
+"""The generational genetic algorithm of the paper, with fair fitness, seeding and checkpoints.
+
+One generation, read top to bottom in :meth:`Trainer.step`:
+
+1. **Evaluate** every individual on the same run seeds (common random numbers, so a better
+   fitness means a better rulebook, not a luckier draw) — ``runs_per_eval`` seeds per scenario,
+   fresh each generation (so no rulebook is fitted to a fixed set of seeds).
+   Fitness = mean paper reward (see :mod:`.evaluate`). Elites are re-evaluated on the fresh
+   seeds like everyone else.
+2. **Record** best / mean / median fitness, the generation's best individual (hall of fame).
+3. **Stop** after ``generations`` generations or as soon as the best fitness reaches
+   ``target_fitness`` (the paper's 9750).
+4. **Breed**: the ``elite`` best individuals pass unchanged; the rest are children of
+   tournament selection, simulated binary crossover and polynomial mutation (pymoo's
+   operators, see the package docstring).
+5. **Checkpoint**: the bred population, the generator state and the history go to one file,
+   written atomically, so that resuming after a crash continues exactly where it stopped.
+
+The rulebook returned at the end is not simply the last generation's luckiest individual: the
+hall of fame (each generation's best) and the final top individuals are re-evaluated on a
+separate set of validation seeds and the best mean reward wins. Five runs are a noisy estimate;
+choosing among ~55 candidates on five runs each would mostly pick noise (the winner's curse).
+
+Initialisation (``init="seeded"``, the default): a population of uniformly random genomes is
+flat — measured on ``paper-reference``, random rule constants average out to a tiny sampling
+box and fail every run, so every individual scores -100 and selection has nothing to select.
+So the first generation holds rulebooks that already solve problems — the RRT-equivalent one
+(full box, bias 0.05, step 10°), goal-biased variants of it, the ``expert`` rulebook when its
+bounds meaning matches — and perturbations of them at several scales: small per-rule noise and
+whole-output shifts (which move a bound or the bias everywhere at once, the coarse direction a
+per-rule mutation cannot take). ``init="random"`` gives the paper-style uniform start for
+comparison.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from xfuzzy_rrt.fuzzy.variables import N_OUTPUTS, N_RULES
+from xfuzzy_rrt.training.evaluate import fitness as mean_reward
+from xfuzzy_rrt.training.genome import (
+    GENES_PER_FIS,
+    MF_GENES,
+    N_GENES,
+    constant_genome,
+    encode,
+)
+
+HISTORY_COLUMNS = ["generation", "best_fitness", "mean_fitness", "median_fitness", "wall_s",
+                   "best_median_iterations", "success_rate", "runs", "runs_per_s"]
+
+
+@dataclass(frozen=True)
+class GAConfig:
+    """Everything that determines a training run's result (workers and engine do not)."""
+
+    population: int = 400
+    generations: int = 50
+    runs_per_eval: int = 5
+    target_fitness: float = 9750.0
+    seed: int = 0
+    bounds: str = "absolute"
+    max_iter: int = 10_000
+    elite: int = 8
+    tournament: int = 3
+    crossover_prob: float = 0.9
+    crossover_eta: float = 15.0
+    mutation_rate: float = 0.01
+    mutation_eta: float = 20.0
+    block_rate: float = 0.5
+    block_sigma: float = 0.05
+    init: str = "seeded"
+    validation_runs: int = 50
+    scenarios: tuple[tuple[str, str], ...] = ()  # (name, sha256) of each training scenario
+
+    def __post_init__(self) -> None:
+        from xfuzzy_rrt.errors import InputError
+
+        def need(ok: bool, option: str, message: str) -> None:
+            if not ok:
+                raise InputError(option, message)
+
+        need(2 <= self.population <= 100_000, "--population", f"must lie in [2, 100000], got {self.population}")
+        need(1 <= self.generations <= 100_000, "--generations", f"must lie in [1, 100000], got {self.generations}")
+        need(1 <= self.runs_per_eval <= 10_000, "--runs-per-eval", f"must lie in [1, 10000], got {self.runs_per_eval}")
+        need(np.isfinite(self.target_fitness), "--target-fitness", "must be a finite number")
+        need(0 <= self.seed < 2**63, "--seed", f"must lie in [0, 2^63), got {self.seed}")
+        need(self.bounds in ("absolute", "relative"), "--bounds", f"must be absolute or relative, got {self.bounds!r}")
+        need(1 <= self.max_iter <= 1_000_000, "--max-iter", f"must lie in [1, 1000000], got {self.max_iter}")
+        need(0 <= self.elite < self.population, "--elite", f"must lie in [0, population), got {self.elite}")
+        need(2 <= self.tournament <= self.population, "--tournament", f"must lie in [2, population], got {self.tournament}")
+        need(0.0 <= self.crossover_prob <= 1.0, "--crossover-prob", "must lie in [0, 1]")
+        need(0.0 <= self.mutation_rate <= 1.0, "--mutation-rate", "must lie in [0, 1]")
+        need(self.crossover_eta > 0 and self.mutation_eta > 0, "--eta", "distribution indices must be > 0")
+        need(self.init in ("seeded", "random"), "--init", f"must be seeded or random, got {self.init!r}")
+        need(0 <= self.validation_runs <= 10_000, "--validation-runs", "must lie in [0, 10000]")
+        need(len(self.scenarios) >= 1, "--scenario", "give at least one training scenario")
+
+    def fingerprint(self) -> str:
+        """SHA-256 of the canonical JSON of this configuration (identifies a checkpoint's run)."""
+        blob = json.dumps(asdict(self), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(blob.encode()).hexdigest()
+
+
+# ------------------------------------------------------------------------------ seeds
+
+
+def generation_seeds(seed: int, generation: int, runs: int) -> np.ndarray:
+    """Planner seeds of one generation (shared by all its individuals), from ``(seed, gen)``."""
+    state = np.random.SeedSequence([int(seed), 1, int(generation)]).generate_state(runs, np.uint64)
+    return (state >> np.uint64(1)).astype(np.int64)
+
+
+def validation_seeds(seed: int, runs: int) -> np.ndarray:
+    """Seeds for choosing the final rulebook, disjoint in purpose from every generation's."""
+    state = np.random.SeedSequence([int(seed), 2]).generate_state(runs, np.uint64)
+    return (state >> np.uint64(1)).astype(np.int64)
+
+
+# ------------------------------------------------------------------------------ initial population
+
+
+def seed_genomes(bounds: str, expert=None) -> list[tuple[str, np.ndarray]]:
+    """Named genomes that already solve problems (see the module docstring)."""
+    full = (-180.0, 180.0, -180.0, 180.0)
+    out = [("rrt-equivalent", constant_genome(0.05, full, 10.0))]
+    for bias in (0.1, 0.2, 0.35, 0.5):
+        out.append((f"rrt-bias-{bias}", constant_genome(bias, full, 10.0)))
+    if bounds == "relative":
+        for half in (30.0, 60.0, 90.0):
+            out.append((f"window-{half:g}", constant_genome(0.2, (-half, half, -half, half), 10.0)))
+    if expert is not None and expert.bounds_mode == bounds:
+        knots, consts = expert.arrays()
+        out.append((expert.name, encode(knots, consts)))
+    return out
+
+
+def initial_population(config: GAConfig, rng: np.random.Generator, expert=None) -> np.ndarray:
+    """The first generation ``[population, 3822]`` (deterministic given ``rng``)."""
+    n = config.population
+    if config.init == "random":
+        return rng.random((n, N_GENES))
+    seeds = [g for _, g in seed_genomes(config.bounds, expert)]
+    pop = np.empty((n, N_GENES))
+    k = min(len(seeds), n)
+    pop[:k] = np.array(seeds[:k])
+    scales = (0.02, 0.05, 0.1, 0.2)
+    for i in range(k, n):
+        base = seeds[int(rng.integers(len(seeds)))]
+        sigma = scales[int(rng.integers(len(scales)))]
+        g = base + 0.25 * sigma * rng.standard_normal(N_GENES)
+        g = g.reshape(N_OUTPUTS, GENES_PER_FIS)
+        g[:, MF_GENES:] += term_blocks(rng, sigma, N_OUTPUTS)
+        pop[i] = np.clip(g.reshape(N_GENES), 0.0, 1.0)
+    return pop
+
+
+def term_blocks(rng: np.random.Generator, sigma: float, n_fis: int) -> np.ndarray:
+    """Random *separable* changes of rule constants: ``[n_fis, 625]``.
+
+    For each FIS, ``Δc[t0, t1, t2, t3] = s + Σ_i u_i[t_i]`` with a whole-output shift ``s`` and a
+    per-term offset ``u_i`` for each input (all normal with scale ``sigma``). A rule grid
+    changed this way moves its output coherently — "more goal bias wherever the goal is
+    near", "the joint-1 interval shifts when the goal is to the west" — which a per-rule
+    mutation could only reach by many independent, individually neutral steps.
+    """
+    s = sigma * rng.standard_normal((n_fis, 1, 1, 1, 1))
+    u = sigma * rng.standard_normal((n_fis, 4, 5))
+    grid = (s + u[:, 0, :, None, None, None] + u[:, 1, None, :, None, None]
+            + u[:, 2, None, None, :, None] + u[:, 3, None, None, None, :])
+    return grid.reshape(n_fis, N_RULES)
+
+
+# ------------------------------------------------------------------------------ breeding
+
+
+class _Bounds:
+    """The minimal pymoo problem description its operators need (box [0, 1]^n)."""
+
+    def __init__(self, n: int):
+        from pymoo.core.problem import Problem
+
+        self._p = Problem(n_var=n, xl=np.zeros(n), xu=np.ones(n))
+
+    @property
+    def problem(self):
+        return self._p
+
+
+def _compare_max(pop, P, random_state=None, **kwargs):
+    """Tournament winner: the highest fitness; ties go to the lower population index."""
+    F = pop.get("F")[:, 0]  # pymoo minimises F; we store -fitness
+    S = np.empty(P.shape[0], dtype=int)
+    for i, row in enumerate(P):
+        best = row[0]
+        for j in row[1:]:
+            if F[j] < F[best] or (F[j] == F[best] and j < best):
+                best = j
+        S[i] = best
+    return S
+
+
+def breed(pop: np.ndarray, fit: np.ndarray, config: GAConfig, rng: np.random.Generator) -> np.ndarray:
+    """The next generation: elites unchanged, then selected, crossed and mutated children."""
+    from pymoo.core.population import Population
+    from pymoo.operators.crossover.sbx import SBX
+    from pymoo.operators.mutation.pm import PM
+    from pymoo.operators.selection.tournament import TournamentSelection
+
+    n, n_var = pop.shape
+    problem = _Bounds(n_var).problem
+    order = np.lexsort((np.arange(n), -fit))  # best first, stable
+    elites = pop[order[: config.elite]]
+    n_children = n - config.elite
+    if n_children == 0:
+        return elites.copy()
+    P = Population.new(X=pop, F=-fit[:, None])
+    selection = TournamentSelection(func_comp=_compare_max, pressure=config.tournament)
+    n_matings = (n_children + 1) // 2
+    parents = selection.do(problem, P, n_matings, 2, to_pop=False, random_state=rng)
+    crossover = SBX(prob=config.crossover_prob, eta=config.crossover_eta, prob_var=0.5)
+    off = crossover.do(problem, P, parents, random_state=rng)
+    mutation = PM(prob=1.0, prob_var=config.mutation_rate, eta=config.mutation_eta)
+    off = mutation.do(problem, off, random_state=rng)
+    children = off.get("X")[:n_children].copy()
+    if config.block_rate > 0:
+        # term-block mutation (see term_blocks): one random FIS per chosen child
+        hit = np.flatnonzero(rng.random(n_children) < config.block_rate)
+        fis = rng.integers(N_OUTPUTS, size=hit.size)
+        blocks = term_blocks(rng, config.block_sigma, hit.size)
+        view = children.reshape(n_children, N_OUTPUTS, GENES_PER_FIS)
+        view[hit, fis, MF_GENES:] += blocks
+    return np.vstack([elites, np.clip(children, 0.0, 1.0)])
+
+
+# ------------------------------------------------------------------------------ state + loop
+
+
+@dataclass
+class TrainState:
+    """What a checkpoint holds: enough to continue exactly where training stopped."""
+
+    generation: int  # generations evaluated so far
+    population: np.ndarray  # the population to evaluate next (or the last one when done)
+    rng_state: dict
+    history: list[dict] = field(default_factory=list)
+    hall_of_fame: list[np.ndarray] = field(default_factory=list)  # best genome per generation
+    last_fitness: np.ndarray | None = None  # fitness of the last evaluated generation
+    last_population: np.ndarray | None = None
+    done: bool = False
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    genes: np.ndarray  # the chosen genome
+    validation_fitness: float
+    validation_iterations_median: float
+    validation_success_rate: float
+    chosen_from: str  # e.g. "hall of fame, generation 37"
+    state: TrainState
+
+
+def new_state(config: GAConfig, expert=None) -> TrainState:
+    rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([config.seed, 0])))
+    pop = initial_population(config, rng, expert)
+    return TrainState(generation=0, population=pop, rng_state=rng.bit_generator.state)
+
+
+class Trainer:
+    """Runs generations on an evaluator; callbacks let the CLI show progress and checkpoint."""
+
+    def __init__(self, config: GAConfig, evaluator,
+                 on_generation: Callable[[dict, TrainState], None] | None = None,
+                 on_chunk: Callable[[int, int], None] | None = None):
+        self.config = config
+        self.evaluator = evaluator
+        self.on_generation = on_generation
+        self.on_chunk = on_chunk
+
+    def step(self, state: TrainState) -> TrainState:
+        """Evaluate ``state.population``, record, stop or breed; return the next state."""
+        c = self.config
+        t0 = time.perf_counter()
+        seeds = generation_seeds(c.seed, state.generation, c.runs_per_eval)
+        its = self.evaluator(state.population, seeds, self.on_chunk)
+        fit = mean_reward(its, c.max_iter)
+        best = int(np.lexsort((np.arange(len(fit)), -fit))[0])
+        ok = (its >= 0) & (its < c.max_iter)
+        best_its = np.where(ok[best], its[best], c.max_iter)
+        wall = time.perf_counter() - t0
+        runs = int(its.size)
+        row = {
+            "generation": state.generation + 1,
+            "best_fitness": float(fit[best]),
+            "mean_fitness": float(fit.mean()),
+            "median_fitness": float(np.median(fit)),
+            "wall_s": wall,
+            "best_median_iterations": float(np.median(best_its)),
+            "success_rate": float(ok.mean()),
+            "runs": runs,
+            "runs_per_s": runs / wall if wall > 0 else float("nan"),
+        }
+        generation = state.generation + 1
+        done = generation >= c.generations or fit[best] >= c.target_fitness
+        rng = np.random.Generator(np.random.PCG64())
+        rng.bit_generator.state = state.rng_state
+        next_pop = state.population if done else breed(state.population, fit, c, rng)
+        new = TrainState(
+            generation=generation, population=next_pop, rng_state=rng.bit_generator.state,
+            history=[*state.history, row],
+            hall_of_fame=[*state.hall_of_fame, state.population[best].copy()],
+            last_fitness=fit, last_population=state.population, done=bool(done),
+        )
+        if self.on_generation:
+            self.on_generation(row, new)
+        return new
+
+    def run(self, state: TrainState) -> TrainState:
+        while not state.done:
+            state = self.step(state)
+        return state
+
+    def choose(self, state: TrainState, top: int = 5) -> TrainResult:
+        """Re-evaluate the hall of fame and the final top individuals on validation seeds."""
+        c = self.config
+        cands: list[tuple[str, np.ndarray]] = [
+            (f"hall of fame, generation {g + 1}", genes) for g, genes in enumerate(state.hall_of_fame)]
+        if state.last_fitness is not None and state.last_population is not None:
+            order = np.lexsort((np.arange(len(state.last_fitness)), -state.last_fitness))
+            for rank, i in enumerate(order[:top]):
+                cands.append((f"final generation, rank {rank + 1}", state.last_population[i]))
+        # identical genomes need one evaluation
+        unique: list[tuple[str, np.ndarray]] = []
+        seen: set[bytes] = set()
+        for label, g in cands:
+            key = np.ascontiguousarray(g).tobytes()
+            if key not in seen:
+                seen.add(key)
+                unique.append((label, g))
+        genes = np.array([g for _, g in unique])
+        if c.validation_runs == 0:
+            last = len(state.hall_of_fame) - 1
+            return TrainResult(genes=state.hall_of_fame[last], validation_fitness=float("nan"),
+                               validation_iterations_median=float("nan"),
+                               validation_success_rate=float("nan"),
+                               chosen_from=f"hall of fame, generation {last + 1}", state=state)
+        seeds = validation_seeds(c.seed, c.validation_runs)
+        its = self.evaluator(genes, seeds, self.on_chunk)
+        fit = mean_reward(its, c.max_iter)
+        best = int(np.lexsort((np.arange(len(fit)), -fit))[0])
+        ok = (its[best] >= 0) & (its[best] < c.max_iter)
+        return TrainResult(
+            genes=genes[best], validation_fitness=float(fit[best]),
+            validation_iterations_median=float(np.median(np.where(ok, its[best], c.max_iter))),
+            validation_success_rate=float(ok.mean()), chosen_from=unique[best][0], state=state)
+
+
+def config_dict(config: GAConfig) -> dict[str, Any]:
+    return asdict(config)
+
+
+__all__ = ["GAConfig", "HISTORY_COLUMNS", "TrainResult", "TrainState", "Trainer", "breed",
+           "config_dict", "generation_seeds", "initial_population", "new_state", "seed_genomes",
+           "validation_seeds", "N_RULES"]

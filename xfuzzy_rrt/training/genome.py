@@ -1,0 +1,117 @@
+"""The genome: how 3,822 genes become six fuzzy systems that are always valid.
+
+Layout (the paper's count): per FIS, in OUTPUTS order, 637 genes —
+``4 inputs x 3`` membership genes, then the 625 rule constants in rule-index order — so an
+individual has ``6 x 637 = 3,822`` genes. Every gene lives in ``[0, 1]`` (the GA's bounds), and
+decoding maps it into the fuzzy system, so *whatever crossover and mutation do* (as long as
+they respect the box, which bounded operators do and :func:`decode` re-clips anyway):
+
+- **Peaks stay strictly inside the range and strictly increasing** by stick-breaking: with
+  fractions ``a_k = A_MIN + (A_MAX - A_MIN) * g_k`` in ``[0.05, 0.95]``,
+  ``p1 = lo + a1 (hi - lo)``, ``p2 = p1 + a2 (hi - p1)``, ``p3 = p2 + a3 (hi - p2)``.
+  Every gap is at least 5 % of what remains, so no term degenerates to a spike (which would make
+  the partition ill-conditioned in floating point). The default quarter peaks are
+  ``a = (1/4, 1/3, 1/2)``.
+- **Constants stay inside the output range**: ``c = lo + g (hi - lo)``.
+
+Decoding is vectorised over a whole population (no Python per individual or per gene), and
+:func:`encode` is its exact inverse up to rounding, used to seed the population from existing
+rulebooks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from xfuzzy_rrt.fuzzy.variables import (
+    INPUT_RANGES,
+    INPUTS,
+    N_INPUTS,
+    N_OUTPUTS,
+    N_RULES,
+    N_TERMS,
+    OUTPUT_RANGES,
+    OUTPUTS,
+)
+
+#: Membership genes per input (the three interior peaks; the ends are the range ends).
+MF_GENES_PER_INPUT = N_TERMS - 2
+MF_GENES = N_INPUTS * MF_GENES_PER_INPUT  # 12
+GENES_PER_FIS = MF_GENES + N_RULES  # 637
+N_GENES = N_OUTPUTS * GENES_PER_FIS  # 3,822
+A_MIN = 0.05
+A_MAX = 0.95
+
+_IN_LO = np.array([INPUT_RANGES[n][0] for n in INPUTS])
+_IN_HI = np.array([INPUT_RANGES[n][1] for n in INPUTS])
+_OUT_LO = np.array([OUTPUT_RANGES[n][0] for n in OUTPUTS])
+_OUT_HI = np.array([OUTPUT_RANGES[n][1] for n in OUTPUTS])
+
+
+def _split(genes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(mf [n, 6, 4, 3], consts [n, 6, 625])`` views of a population ``[n, 3822]``."""
+    g = genes.reshape(genes.shape[0], N_OUTPUTS, GENES_PER_FIS)
+    mf = g[:, :, :MF_GENES].reshape(genes.shape[0], N_OUTPUTS, N_INPUTS, MF_GENES_PER_INPUT)
+    return mf, g[:, :, MF_GENES:]
+
+
+def decode(genes) -> tuple[np.ndarray, np.ndarray]:
+    """Engine arrays ``(knots [n, 6, 4, 5], consts [n, 6, 625])`` of a population ``[n, 3822]``.
+
+    A single genome ``[3822]`` is accepted too (then ``n = 1``). Genes are clipped to [0, 1].
+    """
+    genes = np.clip(np.atleast_2d(np.asarray(genes, dtype=np.float64)), 0.0, 1.0)
+    if genes.shape[1] != N_GENES:
+        raise ValueError(f"a genome has {N_GENES} genes, got {genes.shape[1]}")
+    mf, c = _split(genes)
+    a = A_MIN + (A_MAX - A_MIN) * mf
+    lo = np.broadcast_to(_IN_LO[None, None, :], a.shape[:3])
+    hi = np.broadcast_to(_IN_HI[None, None, :], a.shape[:3])
+    knots = np.empty(a.shape[:3] + (N_TERMS,))
+    knots[..., 0] = lo
+    p1 = lo + a[..., 0] * (hi - lo)
+    p2 = p1 + a[..., 1] * (hi - p1)
+    p3 = p2 + a[..., 2] * (hi - p2)
+    knots[..., 1] = p1
+    knots[..., 2] = p2
+    knots[..., 3] = p3
+    knots[..., 4] = hi
+    consts = _OUT_LO[None, :, None] + c * (_OUT_HI - _OUT_LO)[None, :, None]
+    return np.ascontiguousarray(knots), np.ascontiguousarray(consts)
+
+
+def encode(knots, consts) -> np.ndarray:
+    """Genome ``[3822]`` of engine arrays ``knots [6, 4, 5]``, ``consts [6, 625]``.
+
+    Peaks whose fractions fall outside ``[A_MIN, A_MAX]`` (possible for hand-written rulebooks)
+    are clipped to the nearest encodable partition; constants are clipped to their range.
+    """
+    knots = np.asarray(knots, dtype=np.float64)
+    consts = np.asarray(consts, dtype=np.float64)
+    if knots.shape != (N_OUTPUTS, N_INPUTS, N_TERMS) or consts.shape != (N_OUTPUTS, N_RULES):
+        raise ValueError("expected knots [6, 4, 5] and consts [6, 625]")
+    lo = knots[..., 0]
+    hi = knots[..., 4]
+    p1, p2, p3 = knots[..., 1], knots[..., 2], knots[..., 3]
+    a = np.stack([(p1 - lo) / (hi - lo), (p2 - p1) / (hi - p1), (p3 - p2) / (hi - p2)], axis=-1)
+    mf = np.clip((a - A_MIN) / (A_MAX - A_MIN), 0.0, 1.0)
+    c = np.clip((consts - _OUT_LO[:, None]) / (_OUT_HI - _OUT_LO)[:, None], 0.0, 1.0)
+    genome = np.empty((N_OUTPUTS, GENES_PER_FIS))
+    genome[:, :MF_GENES] = mf.reshape(N_OUTPUTS, MF_GENES)
+    genome[:, MF_GENES:] = c
+    return genome.reshape(N_GENES)
+
+
+def constant_genome(goal_bias: float, box: tuple[float, float, float, float],
+                    step: float) -> np.ndarray:
+    """A genome whose six systems output constants (every rule the same value).
+
+    With ``box = (-180, 180, -180, 180)``, bias 0.05 and step 10 in absolute mode this is plain
+    RRT with the baseline's settings (the "RRT-equivalent" rulebook).
+    """
+    from xfuzzy_rrt.fuzzy.variables import default_knots
+
+    knots = np.array([[default_knots(n) for n in INPUTS]] * N_OUTPUTS)
+    values = (goal_bias, *box, step)
+    consts = np.array([[v] * N_RULES for v in values], dtype=np.float64)
+    return encode(knots, consts)

@@ -1,0 +1,239 @@
+"""A whole training job: scenarios in, rulebook directory + history + checkpoints out.
+
+Output layout of ``--out DIR``::
+
+    DIR/rulebook.toml, DIR/<output>.fis   the trained rulebook (written at the end)
+    DIR/history.csv                       one row per generation (rewritten atomically each one)
+    DIR/checkpoint/state.npz              the latest checkpoint (see .checkpoint)
+
+Everything in the rulebook — the six systems *and* the manifest — depends only on the training
+inputs (scenario files, options, ``--seed``), never on the worker count, the engine or an
+interruption: the manifest records a canonical command line rebuilt from the options (not the
+literal argv, which would differ with ``--workers`` or ``--resume``) and no wall-clock time.
+``history.csv``'s ``wall_s`` and ``runs_per_s`` columns are the only measured (non-reproducible)
+numbers a training run writes.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import shlex
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+
+from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.training.ga import HISTORY_COLUMNS, GAConfig, Trainer, TrainResult, new_state
+
+CHECKPOINT_DIR = "checkpoint"
+HISTORY_FILE = "history.csv"
+
+
+@dataclass(frozen=True)
+class TrainingScenario:
+    path: str  # as given (relative paths stay relative, for a reproducible command)
+    sha256: str
+    scenario: object
+
+
+def expand_scenarios(paths: list[Path]) -> list[Path]:
+    """Files as given; a directory means every ``*.toml`` in it (sorted)."""
+    out: list[Path] = []
+    for p in paths:
+        p = Path(p)
+        if p.is_dir():
+            found = sorted(p.glob("*.toml"))
+            if not found:
+                raise InputError(str(p), "directory holds no *.toml scenario files")
+            out.extend(found)
+        else:
+            out.append(p)
+    if not out:
+        raise InputError("--scenario", "give at least one training scenario (file or directory)")
+    return out
+
+
+def load_training_scenarios(paths: list[Path]) -> list[TrainingScenario]:
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.planners.checks import check_planar_2dof
+
+    items = []
+    for p in expand_scenarios(paths):
+        s = load_scenario(p)
+        check_planar_2dof(s)
+        items.append(TrainingScenario(path=str(p), sha256=hashlib.sha256(p.read_bytes()).hexdigest(),
+                                      scenario=s))
+    names = [t.scenario.name for t in items]
+    if len(set(names)) != len(names):
+        dup = sorted({n for n in names if names.count(n) > 1})[0]
+        raise InputError("--scenario", f"two training scenarios share the name {dup!r}")
+    return items
+
+
+def canonical_command(config: GAConfig, scenarios: list[TrainingScenario], out: str) -> str:
+    """The command that reproduces this training run (independent of workers and engine)."""
+    args = ["xfuzzy-rrt", "train"]
+    for t in scenarios:
+        args += ["--scenario", t.path]
+    defaults = GAConfig(scenarios=(("x", "y"),))
+    options = [("population", "--population"), ("generations", "--generations"),
+               ("runs_per_eval", "--runs-per-eval"), ("target_fitness", "--target-fitness"),
+               ("seed", "--seed"), ("bounds", "--bounds"), ("max_iter", "--max-iter"),
+               ("elite", "--elite"), ("tournament", "--tournament"),
+               ("crossover_prob", "--crossover-prob"), ("crossover_eta", "--crossover-eta"),
+               ("mutation_rate", "--mutation-rate"), ("mutation_eta", "--mutation-eta"),
+               ("block_rate", "--block-rate"), ("block_sigma", "--block-sigma"),
+               ("init", "--init"), ("validation_runs", "--validation-runs")]
+    always = {"population", "generations", "runs_per_eval", "target_fitness", "seed", "bounds"}
+    for attr, flag in options:
+        value = getattr(config, attr)
+        if attr in always or value != getattr(defaults, attr):
+            args += [flag, f"{value:g}" if isinstance(value, float) else str(value)]
+    args += ["--out", out]
+    return " ".join(shlex.quote(a) for a in args)
+
+
+def history_frame(history: list[dict]):
+    import pandas as pd
+
+    return pd.DataFrame(history, columns=HISTORY_COLUMNS)
+
+
+def write_history(path: Path, history: list[dict]) -> None:
+    from xfuzzy_rrt.atomic import atomic_path
+
+    with atomic_path(path) as tmp:
+        history_frame(history).to_csv(tmp, index=False, float_format="%.10g")
+
+
+@dataclass
+class TrainJob:
+    """Options of one ``xfuzzy-rrt train`` invocation, resolved and validated."""
+
+    config: GAConfig
+    scenarios: list[TrainingScenario]
+    out: Path
+    resume: bool = False
+    workers: int | None = None
+    scheduler: str | None = None
+    name: str | None = None
+    extra_provenance: dict = field(default_factory=dict)
+
+    @property
+    def checkpoint_dir(self) -> Path:
+        return self.out / CHECKPOINT_DIR
+
+    def check_out(self) -> None:
+        """Refuse to clobber another run: an existing checkpoint needs ``--resume``."""
+        from xfuzzy_rrt.training.checkpoint import checkpoint_file
+
+        if self.out.exists() and not self.out.is_dir():
+            raise InputError(str(self.out), "exists and is not a directory")
+        has = checkpoint_file(self.checkpoint_dir).exists()
+        if has and not self.resume:
+            raise InputError(str(self.checkpoint_dir), "a training checkpoint is already here; "
+                             "pass --resume to continue it or choose another --out")
+
+
+def run_training(job: TrainJob,
+                 on_start: Callable[[str, int], None] | None = None,
+                 on_generation: Callable[[dict], None] | None = None,
+                 on_chunk: Callable[[int, int], None] | None = None,
+                 on_phase: Callable[[str], None] | None = None) -> TrainResult:
+    """Train (or resume), checkpointing every generation; write the rulebook at the end."""
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
+    from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
+    from xfuzzy_rrt.training.evaluate import Problem
+    from xfuzzy_rrt.training.workers import make_evaluator
+
+    job.check_out()
+    config = job.config
+    if job.resume:
+        state = load_checkpoint(job.checkpoint_dir, config)
+    else:
+        expert = None
+        expert_dir = rulebooks_dir() / "expert"
+        if config.init == "seeded" and expert_dir.is_dir():
+            expert = load_rulebook(expert_dir)
+        state = new_state(config, expert)
+    problems = [Problem.from_scenario(t.scenario) for t in job.scenarios]
+    job.out.mkdir(parents=True, exist_ok=True)
+    _remove_stale_temporaries(job)
+    history_path = job.out / HISTORY_FILE
+
+    def checkpoint(row: dict, new) -> None:
+        save_checkpoint(job.checkpoint_dir, new, config)
+        write_history(history_path, new.history)
+        if on_generation:
+            on_generation(row)
+
+    with make_evaluator(problems, config.bounds, config.max_iter, job.workers,
+                        job.scheduler) as evaluator:
+        if on_start:
+            on_start(evaluator.description, state.generation)
+        if state.history:
+            write_history(history_path, state.history)
+        trainer = Trainer(config, evaluator, on_generation=checkpoint, on_chunk=on_chunk)
+        state = trainer.run(state)
+        if on_phase:
+            on_phase(f"choosing the rulebook: {config.validation_runs} validation runs per "
+                     f"scenario for each generation's best")
+        result = trainer.choose(state)
+    write_trained_rulebook(job, result)
+    return result
+
+
+def _remove_stale_temporaries(job: TrainJob) -> None:
+    """Delete temporary files a killed run left beside its outputs (``kill -9`` skips the
+    clean-up of an atomic write; the real files are always complete)."""
+    for folder in (job.out, job.checkpoint_dir):
+        if folder.is_dir():
+            for tmp in folder.glob(".*.tmp"):
+                tmp.unlink(missing_ok=True)
+
+
+def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
+    from xfuzzy_rrt import __version__
+    from xfuzzy_rrt.fuzzy.rulebook import Rulebook, save_rulebook
+    from xfuzzy_rrt.training.genome import decode
+
+    c = job.config
+    knots, consts = decode(result.genes)
+    history = result.state.history
+    name = job.name or job.out.name or "trained"
+    provenance = {
+        "kind": "ga",
+        "command": canonical_command(c, job.scenarios, str(job.out)),
+        "algorithm": "generational GA: tournament selection, SBX crossover, polynomial and "
+                     "term-block mutation, elitism (xfuzzy_rrt.training)",
+        "package_version": __version__,
+        "seed": c.seed,
+        "population": c.population,
+        "generations_max": c.generations,
+        "generations_run": len(history),
+        "runs_per_eval": c.runs_per_eval,
+        "target_fitness": c.target_fitness,
+        "max_iter": c.max_iter,
+        "init": c.init,
+        "final_best_fitness": history[-1]["best_fitness"],
+        "final_mean_fitness": history[-1]["mean_fitness"],
+        "chosen_from": result.chosen_from,
+        "validation_runs_per_scenario": c.validation_runs,
+        "validation_fitness": result.validation_fitness,
+        "validation_median_iterations": result.validation_iterations_median,
+        "validation_success_rate": result.validation_success_rate,
+        "history": HISTORY_FILE,
+        "scenarios": [{"name": t.scenario.name, "file": t.path, "sha256": t.sha256}
+                      for t in job.scenarios],
+        **job.extra_provenance,
+    }
+    description = (f"Trained by the genetic algorithm ({c.bounds} bounds) on "
+                   f"{len(job.scenarios)} scenario(s); see [provenance].")
+    rb = Rulebook.from_arrays(knots[0], consts[0], name=name, bounds_mode=c.bounds,
+                              provenance=provenance, description=description)
+    return save_rulebook(rb, job.out)
+
+
+__all__ = ["TrainJob", "TrainingScenario", "canonical_command", "expand_scenarios",
+           "history_frame", "load_training_scenarios", "run_training"]

@@ -16,7 +16,9 @@ class PlannerName(str, enum.Enum):
 
 def plan(
     scenario: Path = typer.Argument(..., help="Scenario TOML file."),
-    planner: PlannerName = typer.Option(PlannerName.fuzzy_rrt, "--planner", help="Planner."),
+    planner: str = typer.Option(
+        PlannerName.fuzzy_rrt.value, "--planner",
+        help="Planner: rrt, fuzzy-rrt, or ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
     rulebook: Optional[Path] = typer.Option(
         None, "--rulebook", help="Rulebook directory (fuzzy-rrt; default: the shipped default)."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
@@ -29,12 +31,13 @@ def plan(
 ) -> int:
     """Plan a path from the scenario's start to its goal. Exit 1 when no path is found."""
     from xfuzzy_rrt.cli.common import emit_json, load_scenario_warn
-    from xfuzzy_rrt.planners.api import plan_scenario, write_trace_checked
+    from xfuzzy_rrt.planners.api import check_planner, plan_scenario, write_trace_checked
 
+    check_planner(planner, "--planner")
     if trace is not None:
         write_trace_checked(trace)  # reject a bad suffix before any work is done
     s = load_scenario_warn(scenario)
-    if planner is PlannerName.fuzzy_rrt:
+    if planner == PlannerName.fuzzy_rrt.value:
         from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
 
         rulebook = rulebook if rulebook is not None else default_rulebook_path()
@@ -42,7 +45,7 @@ def plan(
     else:
         rulebook_obj = None
     result = plan_scenario(
-        s, planner=planner.value, rulebook=rulebook_obj, seed=seed, max_iter=max_iter,
+        s, planner=planner, rulebook=rulebook_obj, seed=seed, max_iter=max_iter,
         step_deg=step_deg, goal_bias=goal_bias, trace=trace is not None,
     )
     if trace is not None:

@@ -1,0 +1,197 @@
+"""OMPL planners run as peers on our checker; their sampled edges are certified afterwards.
+
+These tests need the optional 'ompl' extra and do not skip without it: CI installs it, and a
+skipped peer comparison is not a passed one.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import FIXTURES, PROJECT, shared_scenarios
+from exact_geometry import Oracle
+from xfuzzy_rrt.cli.main import main
+from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, config_free
+from xfuzzy_rrt.geometry.path_check import certify_path
+from xfuzzy_rrt.geometry.scenario import load_scenario
+from xfuzzy_rrt.planners.api import PLANNERS, check_planner, is_known_planner, plan_scenario
+from xfuzzy_rrt.planners.ompl_bridge import MISSING_EXTRA, make_validity_callback, plan_ompl
+from xfuzzy_rrt.planners.result import path_cost_deg
+
+SCENARIOS = (sorted((FIXTURES / "scenarios").glob("*.toml"))
+             + sorted((PROJECT / "xfuzzy_rrt" / "data" / "scenarios").glob("*.toml"))
+             + [p for p in shared_scenarios() if p.stem == "paper-reference"])
+TWO_CIRCLES = FIXTURES / "scenarios" / "two-circles.toml"
+PEERS = ("ompl:RRT", "ompl:RRTConnect", "ompl:RRTstar", "ompl:BITstar")
+
+THIN_BOX = """
+name = "thin-box"
+description = "a 4 mm box across the sweep of the straight arm, between coarse motion samples"
+[arm]
+links = [0.18, 0.12]
+link_radius = 0.005
+[start]
+q_deg = [-60.0, 0.0]
+[goal]
+q_deg = [60.0, 0.0]
+[[obstacles]]
+type = "box"
+min = [0.2, -0.002]
+max = [0.28, 0.002]
+"""
+
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
+def test_ompl_paths_run_start_to_goal_exactly_and_certification_agrees_with_the_oracle(path):
+    s = load_scenario(path)
+    a = s.arrays()
+    oracle = Oracle(path)
+    for planner in PEERS:
+        for seed in range(4):
+            r = plan_scenario(s, planner=planner, seed=seed)
+            assert r.planner == planner and r.success, (planner, seed)
+            assert np.array_equal(r.path_deg[0], a.start_deg)
+            assert np.array_equal(r.path_deg[-1], a.goal_deg)
+            assert r.cost_deg == pytest.approx(path_cost_deg(r.path_deg))
+            assert r.nodes == len(r.tree_nodes_deg) > 0 and r.iterations > 0
+            check = certify_path(a, r.path_deg)
+            assert r.params["certified"] == check.certified
+            assert r.params["penetration_m"] == check.penetration_m
+            problems = oracle.path_problems(r.path_deg)
+            if check.certified:
+                assert problems == [], (planner, seed)  # never silently accepted
+            if problems:
+                assert not check.certified and check.penetration_m > 0.0, (planner, seed)
+
+
+def test_a_grazing_edge_that_ompl_samples_past_is_flagged_with_its_depth(tmp_path):
+    # One straight motion start -> goal (goal bias 1, huge range), checked by OMPL at 5 % of
+    # the extent (~25 deg): its samples at -36, -12, 12, 36 deg miss the box at 0 deg.
+    file = tmp_path / "thin-box.toml"
+    file.write_text(THIN_BOX)
+    s = load_scenario(file)
+    r = plan_ompl(s, "ompl:RRT", seed=0, step_deg=1000.0, goal_bias=1.0,
+                  validity_resolution=0.05)
+    assert r.success and r.path_deg.tolist() == [[-60.0, 0.0], [60.0, 0.0]]
+    assert Oracle(file).path_problems(r.path_deg), "the oracle sees the collision"
+    check = certify_path(s.arrays(), r.path_deg)
+    assert not check.certified and check.worst_segment == 0
+    assert check.penetration_m == pytest.approx(0.007, abs=1e-4)  # 2 mm box half + 5 mm radius
+    assert r.params["certified"] is False and r.params["penetration_m"] > 0.0
+    # With a fine motion check OMPL itself refuses that edge and finds another way.
+    fine = plan_ompl(s, "ompl:RRT", seed=0, step_deg=1000.0, goal_bias=1.0,
+                     validity_resolution=0.001)
+    assert not fine.success or len(fine.path_deg) > 2
+
+
+def test_the_same_seed_repeats_the_run_and_other_seeds_differ():
+    s = load_scenario(TWO_CIRCLES)
+    for planner in PEERS:
+        runs = [plan_scenario(s, planner=planner, seed=7) for _ in range(2)]
+        assert np.array_equal(runs[0].path_deg, runs[1].path_deg)
+        assert runs[0].iterations == runs[1].iterations and runs[0].nodes == runs[1].nodes
+        others = {plan_scenario(s, planner=planner, seed=k).path_deg.tobytes() for k in range(4)}
+        assert len(others) > 1, planner
+
+
+def test_rrt_iterations_counted_by_the_termination_condition_equal_rrtstar_own_counter():
+    # Same seed, same goal bias and range: RRT* draws the same samples and adds the same nodes
+    # as RRT until the first solution, and it counts its iterations itself.
+    s = load_scenario(TWO_CIRCLES)
+    for seed in range(5):
+        rrt = plan_scenario(s, planner="ompl:RRT", seed=seed)
+        star = plan_scenario(s, planner="ompl:RRTstar", seed=seed)
+        assert rrt.params["iterations_source"] == "termination-condition evaluations"
+        assert star.params["iterations_source"] == "numIterations"
+        assert rrt.iterations == star.iterations and rrt.nodes == star.nodes
+
+
+def test_the_iteration_budget_ends_a_run_as_a_failure():
+    s = load_scenario(TWO_CIRCLES)
+    r = plan_scenario(s, planner="ompl:RRT", seed=0, max_iter=5)
+    assert not r.success and r.iterations == 5 and r.cost_deg is None
+    assert r.path_deg.shape == (0, 2) and r.params["stopped_by"] == "max_iter"
+
+
+def test_settings_are_ours_and_recorded():
+    s = load_scenario(TWO_CIRCLES)
+    r = plan_scenario(s, planner="ompl:RRT", seed=1)
+    p = r.params
+    assert p["range_deg"] == 10.0 and p["goal_bias"] == 0.05 and p["margin_m"] == CERT_MARGIN_M
+    assert p["validity_resolution_deg"] == pytest.approx(0.01 * np.hypot(360.0, 360.0))
+    bit = plan_scenario(s, planner="ompl:BITstar", seed=1).params
+    assert bit["range_deg"] is None and bit["goal_bias"] is None  # BIT* has neither
+    json.dumps(r.to_json_dict())  # plain types only
+
+
+def test_the_validity_callback_is_our_checker():
+    from ompl import base as ob
+
+    a = load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml").arrays()
+    callback = make_validity_callback(a)
+    space = ob.RealVectorStateSpace(2)
+    state = space.allocState()
+    rng = np.random.default_rng(5)
+    qs = rng.uniform(-185.0, 185.0, size=(2000, 2))  # some outside the joint limits too
+    ours = []
+    for q in qs:
+        state[0], state[1] = float(q[0]), float(q[1])
+        ours.append(bool(callback(state)))
+    expected = [bool(config_free(a.links, a.base, a.link_radius, a.obstacles, a.limits_deg, q,
+                                 CERT_MARGIN_M)) for q in qs]
+    assert ours == expected and 0 < sum(ours) < len(ours)
+
+
+def test_unknown_and_unsupported_ompl_planners_are_one_clear_input_error():
+    s = load_scenario(TWO_CIRCLES)
+    with pytest.raises(InputError, match=r"unknown OMPL planner 'Nope' \(known: .*RRTConnect"):
+        plan_scenario(s, planner="ompl:Nope")
+    with pytest.raises(InputError, match="PRM' is not supported: .*thread") as info:
+        check_planner("ompl:PRM")
+    assert info.value.where == "--planners"
+    assert is_known_planner("ompl:RRT") and not is_known_planner("ompl:")
+    assert PLANNERS == ("rrt", "fuzzy-rrt")
+
+
+def test_without_the_extra_ompl_planners_name_the_extra(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "ompl", None)  # `import ompl` now raises ImportError
+    s = load_scenario(TWO_CIRCLES)
+    with pytest.raises(InputError) as info:
+        plan_scenario(s, planner="ompl:RRT")
+    assert (info.value.where, info.value.message) == ("--planners", MISSING_EXTRA)
+    code = main(["plan", str(TWO_CIRCLES), "--planner", "ompl:RRT"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == ""
+    assert err == f"error: --planners: {MISSING_EXTRA}\n"
+
+
+def test_without_the_extra_the_console_script_prints_one_error_line(tmp_path, monkeypatch):
+    # A module named 'ompl' that fails to import shadows the installed wheel.
+    (tmp_path / "ompl.py").write_text("raise ImportError('simulated: the ompl extra is missing')\n")
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))
+    import subprocess
+
+    from conftest import console_script
+
+    proc = subprocess.run([console_script(), "plan", str(TWO_CIRCLES), "--planner", "ompl:RRT"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr == f"error: --planners: {MISSING_EXTRA}\n"
+
+
+def test_cli_plan_with_an_ompl_planner_repeats_across_processes(run_cli):
+    runs = []
+    for _ in range(2):
+        proc = run_cli("plan", TWO_CIRCLES, "--planner", "ompl:RRTConnect", "--seed", "4")
+        assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+        data = json.loads(proc.stdout)
+        data.pop("wall_s")
+        runs.append(data)
+    assert runs[0] == runs[1]
+    assert runs[0]["planner"] == "ompl:RRTConnect" and runs[0]["params"]["ompl_seed"] == 5
+    assert runs[0]["path_deg"][0] == [-120.0, 30.0] and runs[0]["path_deg"][-1] == [150.0, -60.0]

@@ -1,0 +1,169 @@
+"""certify_path vouches only for paths that are free everywhere and measures how deep bad ones go."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from conftest import FIXTURES, PROJECT
+from exact_geometry import Oracle
+from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.geometry.collision import clearance
+from xfuzzy_rrt.geometry.path_check import (
+    PathCheck,
+    certify_path,
+    signed_clearance,
+    signed_segment_obstacle_dist,
+)
+from xfuzzy_rrt.geometry.scenario import load_scenario
+from xfuzzy_rrt.planners.rrt import plan_rrt
+
+SCENARIOS = sorted((FIXTURES / "scenarios").glob("*.toml")) + sorted(
+    (PROJECT / "xfuzzy_rrt" / "data" / "scenarios").glob("*.toml"))
+PAPERISH = FIXTURES / "scenarios" / "two-circles.toml"
+
+THIN_BOX_TOML = """
+name = "thin-box"
+description = "a thin box lying across the sweep of a straight arm"
+[arm]
+links = [0.18, 0.12]
+link_radius = 0.005
+joint_limits_deg = [[-180.0, 180.0], [-180.0, 180.0]]
+[start]
+q_deg = [-60.0, 0.0]
+[goal]
+q_deg = [60.0, 0.0]
+[[obstacles]]
+type = "box"
+min = [0.2, {ylo}]
+max = [0.28, {yhi}]
+"""
+
+
+def thin_box(tmp_path, ylo=-0.002, yhi=0.002):
+    path = tmp_path / "thin-box.toml"
+    path.write_text(THIN_BOX_TOML.format(ylo=ylo, yhi=yhi))
+    return path
+
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
+def test_rrt_paths_are_certified_with_zero_penetration_and_the_oracle_agrees(path):
+    s = load_scenario(path)
+    oracle = Oracle(path)
+    for seed in range(5):
+        r = plan_rrt(s, seed=seed)
+        check = certify_path(s.arrays(), r.path_deg)
+        assert check == PathCheck(certified=True, penetration_m=0.0, worst_segment=-1)
+        assert oracle.path_problems(r.path_deg) == []
+
+
+def test_a_straight_path_through_obstacles_is_flagged_with_its_depth():
+    s = load_scenario(PAPERISH)
+    oracle = Oracle(PAPERISH)
+    path = np.array([s.start_deg, s.goal_deg])
+    assert oracle.path_problems(path), "fixture: the straight line must collide"
+    check = certify_path(s.arrays(), path)
+    assert not check.certified
+    assert check.penetration_m > 0.0 and check.worst_segment == 0
+
+
+def test_the_worst_segment_is_the_one_that_goes_deepest(tmp_path):
+    file = thin_box(tmp_path)
+    s = load_scenario(file)
+    # Unfold away from the box, sweep straight through it, fold again: only segment 1 collides.
+    path = np.array([[-60.0, 150.0], [-60.0, 0.0], [60.0, 0.0], [60.0, 150.0]])
+    oracle = Oracle(file)
+    assert [bool(oracle.path_problems(path[i:i + 2])[-1:] and "colliding" in
+                 oracle.path_problems(path[i:i + 2])[-1]) for i in range(3)] == [False, True, False]
+    check = certify_path(s.arrays(), path)
+    assert not check.certified and check.worst_segment == 1
+
+
+def test_shallow_penetration_matches_the_oracle_clearance(tmp_path):
+    # The box face sits 3 mm from the arm's centre line at 0 deg: a 5 mm capsule goes 2 mm in.
+    file = thin_box(tmp_path, ylo=0.003, yhi=0.007)
+    s = load_scenario(file)
+    oracle = Oracle(file)
+    path = np.array([[-1.0, 0.0], [0.0, 0.0]])  # deepest at 0 deg, on the face side only
+    check = certify_path(s.arrays(), path)
+    dense = oracle.densify(path, 0.001)
+    deepest = -float(np.min(oracle.clearance(dense)))
+    assert not check.certified
+    assert check.penetration_m == pytest.approx(0.002, abs=1e-4)
+    assert check.penetration_m == pytest.approx(deepest, abs=1e-4)
+
+
+def test_deep_penetration_does_not_saturate_at_the_link_radius(tmp_path):
+    # Unsigned clearance bottoms out at -link_radius once the centre line touches; the signed
+    # depth keeps going: centre line through the middle of a 4 mm box -> 2 mm + 5 mm.
+    file = thin_box(tmp_path)
+    s = load_scenario(file)
+    a = s.arrays()
+    assert clearance(a, [0.0, 0.0]) == pytest.approx(-0.005)
+    assert signed_clearance(a, [0.0, 0.0]) == pytest.approx(-0.007)
+    check = certify_path(a, np.array([[-60.0, 0.0], [60.0, 0.0]]))
+    assert check.penetration_m == pytest.approx(0.007, abs=1e-4)
+
+
+def test_a_vertex_outside_the_joint_limits_is_not_certified_even_without_penetration():
+    s = load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml")  # joint 1 up to 175
+    inside = np.array([[160.0, 90.0], [170.0, 90.0]])
+    assert certify_path(s.arrays(), inside) == PathCheck(True, 0.0, -1)
+    path = np.array([[160.0, 90.0], [170.0, 90.0], [178.0, 90.0]])
+    check = certify_path(s.arrays(), path)
+    assert not check.certified and check.penetration_m == 0.0 and check.worst_segment == 1
+
+
+def test_an_empty_path_is_not_certified_and_a_malformed_one_is_rejected():
+    a = load_scenario(PAPERISH).arrays()
+    assert certify_path(a, np.zeros((0, 2))) == PathCheck(False, 0.0, -1)
+    with pytest.raises(InputError):
+        certify_path(a, np.zeros((3, 3)))
+    with pytest.raises(InputError):
+        certify_path(a, np.array([[0.0, np.nan], [1.0, 1.0]]))
+
+
+def _minkowski_signed_distance(a, b, poly):
+    """Independent: signed distance of segment AB to a convex polygon via shapely.
+
+    Translating AB by t hits ``poly`` iff t lies in ``poly ⊕ (-AB)``, the convex hull of the
+    polygon's corners shifted by -A and -B. The segment meets the polygon iff the origin is in
+    it; the distance (or the penetration depth) is the distance from the origin to its boundary.
+    """
+    corners = np.asarray(poly.exterior.coords)[:-1]
+    hull = shapely.MultiPoint(np.vstack([corners - a, corners - b])).convex_hull
+    origin = shapely.Point(0.0, 0.0)
+    d = hull.exterior.distance(origin)
+    return -d if hull.contains(origin) or hull.exterior.distance(origin) == 0.0 else d
+
+
+# Micrometre grid: shapely mis-measures segments of subnormal length, which are not our concern.
+COORD = st.floats(-1.0, 1.0, allow_nan=False).map(lambda v: round(v, 6))
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    coords=st.lists(COORD, min_size=8, max_size=8),
+)
+def test_signed_box_distance_equals_the_minkowski_difference_oracle(coords):
+    ax, ay, bx, by, x0, y0, w, h = coords
+    w, h = abs(w) + 0.05, abs(h) + 0.05
+    row = np.array([1.0, x0, y0, x0 + w, y0 + h])
+    ours = signed_segment_obstacle_dist(ax, ay, bx, by, row)
+    theirs = _minkowski_signed_distance(np.array([ax, ay]), np.array([bx, by]),
+                                        shapely.box(x0, y0, x0 + w, y0 + h))
+    assert ours == pytest.approx(theirs, abs=1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(coords=st.lists(COORD, min_size=6, max_size=6))
+def test_signed_circle_distance_is_centre_distance_minus_radius(coords):
+    ax, ay, bx, by, cx, cy = coords
+    r = 0.3
+    row = np.array([0.0, cx, cy, r, 0.0])
+    seg = shapely.LineString([(ax, ay), (bx, by)]) if (ax, ay) != (bx, by) else shapely.Point(ax, ay)
+    expected = seg.distance(shapely.Point(cx, cy)) - r
+    assert signed_segment_obstacle_dist(ax, ay, bx, by, row) == pytest.approx(expected, abs=1e-12)

@@ -2,24 +2,28 @@
 
 The report is read by auditors who may open it on an air-gapped machine, so the checks that
 matter are: plotly.js embedded exactly once and no script fetched from the network; the
-scenario, the summary numbers and every figure present; escaping of user-supplied text; and the
-same inputs giving the same bytes (apart from the date line). The CLI test drives the real
-console script end to end (runs.csv, summary.csv with the SPEC columns, report.html).
+scenarios, planners, summary numbers and every figure present; escaping of user-supplied text
+(a scenario may be named ``<script>alert(1)</script>``); the drill-down showing the very numbers
+``xfuzzy-rrt explain`` prints; ``xfuzzy-rrt report DIR`` rebuilding the same page from the
+files on disk without planning; a training curve when a history is given.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import json
 import re
+import shutil
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from conftest import FIXTURES
+from conftest import FIXTURES, PROJECT
 
 TWO_CIRCLES = FIXTURES / "scenarios" / "two-circles.toml"
 BOXES = FIXTURES / "scenarios" / "boxes-and-circle.toml"
+EXPERT = PROJECT / "rulebooks" / "expert"
 
 SPEC_RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "nodes", "cost_deg",
                     "wall_s"]
@@ -46,6 +50,17 @@ def _assert_offline(text: str) -> None:
     assert text.count(_plotlyjs()) == 1
 
 
+def _figures(text: str) -> dict:
+    m = re.search(r'<script type="application/json" id="xf-figs">(.*?)</script>', text, re.S)
+    return json.loads(m.group(1))
+
+
+def _drill(text: str, idx: int = 0) -> dict:
+    m = re.search(rf'<script type="application/json" id="drill-s{idx}-data">(.*?)</script>',
+                  text, re.S)
+    return json.loads(m.group(1))
+
+
 @pytest.fixture(scope="module")
 def scenario():
     from xfuzzy_rrt.geometry.scenario import load_scenario
@@ -58,6 +73,20 @@ def bench(scenario):
     from xfuzzy_rrt.bench.runner import run_benchmark
 
     return run_benchmark([scenario], ["rrt"], runs=3)
+
+
+@pytest.fixture(scope="module")
+def full(tmp_path_factory):
+    """RRT and Fuzzy-RRT on two scenarios, written by the CLI's writer (tables + report)."""
+    from xfuzzy_rrt.bench.runner import run_benchmark
+    from xfuzzy_rrt.cli.bench import write_outputs
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    result = run_benchmark([load_scenario(TWO_CIRCLES), load_scenario(BOXES)],
+                           ["rrt", "fuzzy-rrt"], runs=4, rulebook=EXPERT)
+    out = tmp_path_factory.mktemp("full")
+    result = write_outputs(result, out, "xfuzzy-rrt bench two-circles.toml boxes-and-circle.toml")
+    return result, out, (out / "report.html").read_text(encoding="utf-8")
 
 
 @pytest.fixture(scope="module")
@@ -110,9 +139,10 @@ def test_report_is_written_offline_with_numbers_and_figures(bench, tmp_path):
 
     for div_id in ("fig-boxplots", "fig-s0-rrt-joint", "fig-s0-rrt-workspace"):
         assert f'id="{div_id}"' in text
-    # Every figure div is drawn by a newPlot call on the same id.
+    # Every figure div has exactly one figure specification under the same id.
     ids = re.findall(r'<div id="(fig-[^"]+)" class="plotly-graph-div"', text)
     assert len(ids) == len(set(ids)) == 3
+    assert set(_figures(text)) == set(ids)
     # The example run is identified so that it can be reproduced.
     ex = bench.examples[("two-circles", "rrt")]
     assert f"--planner rrt --seed {ex.seed}" in text
@@ -129,22 +159,198 @@ def test_report_is_deterministic_and_escapes_text(bench):
     assert "&lt;script&gt;alert(1)&lt;/script&gt;" in one
 
 
+def test_scenario_named_like_a_script_appears_escaped_everywhere(run_cli, tmp_path):
+    evil = tmp_path / "evil.toml"
+    text = TWO_CIRCLES.read_text()
+    text = re.sub(r'^name = .*$', 'name = "<script>alert(1)</script>"', text, count=1,
+                  flags=re.M)
+    evil.write_text(text)
+    out = tmp_path / "out"
+    proc = run_cli("bench", evil, "--planners", "rrt,fuzzy-rrt", "--runs", "2", "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "<script>alert(1)</script>" not in html
+    assert "alert(1)</script>" not in html  # not even inside the embedded JSON
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in html
+    # Figure titles carry it HTML-escaped (plotly renders a subset of HTML in them).
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in json.dumps(_figures(html)["fig-boxplots"])
+    assert re.search(r"Scenario: &lt;script&gt;alert\(1\)&lt;/script&gt;", html)
+
+
+def test_report_names_every_planner_and_scenario(full):
+    result, _, text = full
+    _assert_offline(text)
+    for name in ("two-circles", "boxes-and-circle"):
+        assert f"Scenario: {name}" in text
+    for label in ("RRT", "Fuzzy-RRT"):
+        assert f"<td class=\"txt\">{label}</td>" in text
+    for (scen, planner) in result.examples:
+        idx = list(result.scenarios).index(scen)
+        assert f'id="fig-s{idx}-{planner}-joint"' in text
+
+
+def test_report_has_follow_one_plan_fuzzy_systems_and_provenance(full):
+    result, _, text = full
+    figs = _figures(text)
+    for fig_id in ("fig-s0-firing", "fig-s0-io", "fig-s0-drill", "fig-mf-0", "fig-surfaces",
+                   "fig-ratios", "fig-s1-firing"):
+        assert fig_id in figs, fig_id
+    assert "fixed: angle_to_goal = " in json.dumps(figs["fig-surfaces"]["layout"]["title"])
+    rb = result.rulebook
+    assert rb.sha256 in text
+    assert result.provenance["versions"]["numpy"] in text
+    sha = result.provenance["scenarios"]["two-circles"]["sha256"]
+    assert sha[:16] in text
+    assert "Reproduce: <code>xfuzzy-rrt rules show " in text
+    assert "xfuzzy-rrt explain trace.parquet --rulebook" in text
+    # The plotly template is stored once for all figures (not once per figure).
+    assert text.replace(_plotlyjs(), "").count('"histogram2dcontour":') == 1
+
+
+def test_drilldown_numbers_equal_what_explain_prints(full, run_cli):
+    result, out, text = full
+    payload = _drill(text, 0)
+    index = json.loads((out / "examples" / "index.json").read_text())
+    entry = next(e for e in index if e["scenario"] == "two-circles" and e["planner"] == "fuzzy-rrt")
+    record = payload["iterations"][len(payload["iterations"]) // 2]
+    proc = run_cli("explain", out / "examples" / entry["trace"], "--iteration",
+                   str(record["iteration"]), "--rulebook", EXPERT)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert lines[0].startswith(f"Iteration {record['iteration']} ")
+    for name, value, note in record["inputs"]:
+        assert f"  {name:18s} = {value}" + (f" ({note})" if note else "") in lines
+    active = None
+    for output, act, rules, value, recorded in record["systems"]:
+        active = act or active
+        start = lines.index(f"== {output} ==")
+        block = lines[start:]
+        for name, terms in active:
+            assert f"  {name:18s}: {terms}" in block[:6]
+        for idx, strength, contribution in rules:
+            const = payload["consts"][output][str(idx)]
+            const = const[1] if isinstance(const, list) else const
+            k = block.index(next(line for line in block if line.startswith(f"    r{idx}: ")))
+            assert block[k + 1] == f"          strength {strength} \u00d7 {const} = {contribution}"
+        assert f"  {output} = \u03a3 contributions = {value}  (planner recorded {recorded})" in block
+    decision = lines[lines.index("Decision:") + 1:]
+    for line in record["decision"]:
+        assert f"  {line}" in decision
+    assert len(rules) >= 1
+
+
+def test_drilldown_selects_path_expansions_within_budget(full):
+    from xfuzzy_rrt.report.drilldown import per_scenario, select_iterations
+
+    result, _, _ = full
+    trace = result.examples[("two-circles", "fuzzy-rrt")].trace
+    its = select_iterations(trace, 12)
+    assert len(its) == 12 and its == sorted(set(its))
+    assert its[0] == 1
+    on_path = set(trace.loc[trace["on_path"], "iteration"])
+    assert int(trace["iteration"].iloc[-1]) in its  # the goal expansion
+    assert len(on_path & set(its)) >= 6
+    assert per_scenario(1) == 40 and per_scenario(24) == 5
+
+
+def test_report_dir_rebuilds_the_same_page_without_planning(full, monkeypatch, tmp_path):
+    from xfuzzy_rrt.bench.store import load_bench_dir
+    from xfuzzy_rrt.cli.main import main
+    from xfuzzy_rrt.planners import api, fuzzy_rrt, rrt
+    from xfuzzy_rrt.report.bench_report import render_bench_report
+
+    result, out, _ = full
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    (copy / "report.html").unlink()
+
+    def boom(*a, **k):
+        raise AssertionError("report must not plan")
+
+    for mod, name in ((api, "plan_scenario"), (rrt, "plan_rrt"), (fuzzy_rrt, "plan_fuzzy_rrt")):
+        monkeypatch.setattr(mod, name, boom)
+    assert main(["report", str(copy)]) == 0
+    rebuilt = (copy / "report.html").read_text(encoding="utf-8")
+    assert "Scenario: boxes-and-circle" in rebuilt and 'id="fig-s1-drill"' in rebuilt
+    again = load_bench_dir(copy)
+    assert render_bench_report(again, generated_at="T") == render_bench_report(result,
+                                                                                generated_at="T")
+
+
+def test_report_shows_the_training_curve_from_history(full, tmp_path, run_cli):
+    _, out, text = full
+    assert 'id="fig-training"' not in text
+    history = tmp_path / "history.csv"
+    pd.DataFrame({"generation": [0, 1, 2], "best_fitness": [3.0, 2.0, 1.5],
+                  "mean_fitness": [5.0, 4.0, 3.0], "median_fitness": [4.5, 3.5, 2.9],
+                  "wall_s": [1.0, 1.0, 1.0]}).to_csv(history, index=False)
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    proc = run_cli("report", copy, "--history", history)
+    assert proc.returncode == 0, proc.stderr
+    html = (copy / "report.html").read_text(encoding="utf-8")
+    fig = _figures(html)["fig-training"]
+    assert [t["name"] for t in fig["data"]] == ["best", "mean", "median"]
+    assert str(history) in html
+
+
+def test_training_history_named_by_the_rulebook_manifest_is_found(tmp_path):
+    from xfuzzy_rrt.bench.runner import run_benchmark
+    from xfuzzy_rrt.cli.bench import write_outputs
+    from xfuzzy_rrt.fuzzy.manifest import thaw
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, save_rulebook
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    rb = load_rulebook(EXPERT)
+    trained = tmp_path / "trained"
+    save_rulebook(dataclasses.replace(rb, provenance={**thaw(rb.provenance),
+                                                      "history": "history.csv"}), trained)
+    pd.DataFrame({"generation": [0, 1], "best_fitness": [2.0, 1.0], "mean_fitness": [3.0, 2.0],
+                  "median_fitness": [2.5, 1.8], "wall_s": [1.0, 1.0]}).to_csv(
+        trained / "history.csv", index=False)
+    result = run_benchmark([load_scenario(TWO_CIRCLES)], ["fuzzy-rrt"], runs=2, rulebook=trained)
+    write_outputs(result, tmp_path / "out", "cmd")
+    html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+    assert "fig-training" in _figures(html)
+
+
+def test_report_on_a_folder_without_bench_json_is_one_error_line(run_cli, tmp_path):
+    proc = run_cli("report", tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [
+        f"error: {tmp_path / 'bench.json'}: missing (not a folder written by 'xfuzzy-rrt bench')"]
+
+
+def test_report_with_a_different_rulebook_is_refused(full, run_cli, tmp_path):
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, save_rulebook
+
+    _, out, _ = full
+    rb = load_rulebook(EXPERT)
+    other = tmp_path / "other"
+    save_rulebook(dataclasses.replace(rb, name="other"), other)
+    proc = run_cli("report", out, "--rulebook", other)
+    assert proc.returncode == 2
+    assert "is not the one this benchmark used" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+
+
 def test_two_planner_report_has_ratios_outcomes_and_placeholders(two_planner_bench):
     from xfuzzy_rrt.report.bench_report import render_bench_report
 
     text = render_bench_report(two_planner_bench, "cmd", generated_at="t")
     _assert_offline(text)
-    assert "Fuzzy-RRT relative to RRT" in text
+    assert "Relative to RRT" in text
     s = two_planner_bench.summary.set_index(["scenario", "planner"])
-    ratio = (s.loc[("two-circles", "fuzzy-rrt"), "iterations_median"]
-             / s.loc[("two-circles", "rrt"), "iterations_median"])
+    ratio = (s.loc[("two-circles", "rrt"), "iterations_median"]
+             / s.loc[("two-circles", "fuzzy-rrt"), "iterations_median"])
     assert f"{ratio:.2f}" in text
     for div_id in ("fig-s0-rrt-joint", "fig-s0-fuzzy-rrt-joint", "fig-s0-fuzzy-rrt-workspace",
-                   "fig-s0-outcomes", "fig-s1-rrt-joint"):
+                   "fig-s0-outcomes", "fig-s1-rrt-joint", "fig-ratios"):
         assert f'id="{div_id}"' in text
     # No fuzzy example on the second scenario, and no trace there: skipped gracefully.
     assert 'id="fig-s1-fuzzy-rrt-joint"' not in text
     assert 'id="fig-s1-outcomes"' not in text
+    assert 'id="fig-s0-drill"' not in text  # a trace without fired rules cannot be followed
     assert "Fuzzy-RRT: no successful run to show" in text
     # Planner order is RRT then Fuzzy-RRT whatever the settings order.
     assert text.index('id="fig-s0-rrt-joint"') < text.index('id="fig-s0-fuzzy-rrt-joint"')
@@ -181,6 +387,27 @@ def test_figures_geometry(scenario, bench):
     assert F.outcome_figure({"rrt": r}) is None  # plain RRT has no trace
 
 
+def test_compact_figure_json_round_trips_arrays_and_shares_repeats():
+    import plotly.graph_objects as go
+
+    from xfuzzy_rrt.report.plotjson import SharedStore, _decode, figure_spec, script_json
+
+    shared = SharedStore()
+    grid = (np.arange(10_000).reshape(100, 100) % 3 == 0).astype(np.uint8)
+    xs = np.linspace(-180, 180, 500)
+    specs = [figure_spec(go.Figure([go.Heatmap(z=grid), go.Scatter(x=xs, y=xs)]), shared)
+             for _ in range(3)]
+    assert specs[0] == specs[1] == specs[2]
+    heat, line = specs[0]["data"]
+    bits = shared.values[heat["z"]["$ref"]]
+    unpacked = np.unpackbits(np.frombuffer(__import__("base64").b64decode(bits["$bits"]),
+                                           dtype=np.uint8))[:10_000].reshape(100, 100)
+    np.testing.assert_array_equal(unpacked, grid)
+    x = _decode(shared.values[line["x"]["$ref"]])
+    assert x.dtype == np.float32 and np.allclose(x, xs, atol=1e-4)
+    assert "<" not in script_json({"t": "</script><b>&"})
+
+
 def test_bench_cli_writes_tables_and_report(run_cli, tmp_path):
     out = tmp_path / "bench"
     proc = run_cli("bench", TWO_CIRCLES, "--planners", "rrt", "--runs", "3", "--out", out)
@@ -194,29 +421,12 @@ def test_bench_cli_writes_tables_and_report(run_cli, tmp_path):
     _assert_offline(text)
     assert "two-circles" in text
     assert f'<td class="num">{_as_text(summary.loc[0, "iterations_median"])}</td>' in text
-    assert not [p.name for p in out.iterdir() if p.name.startswith(".")]  # no temp files left
+    assert not [p.name for p in out.rglob(".*")]  # no temp files left
 
 
-def test_benchmark_results_do_not_depend_on_the_number_of_workers():
-    from xfuzzy_rrt.bench.runner import run_benchmark
-    from xfuzzy_rrt.geometry.scenario import load_scenario
-
-    s = load_scenario(TWO_CIRCLES)
-    one = run_benchmark([s], ["rrt", "fuzzy-rrt"], runs=6, workers=1)
-    two = run_benchmark([s], ["rrt", "fuzzy-rrt"], runs=6, workers=2)
-    cols = [c for c in one.runs.columns if c != "wall_s"]
-    assert one.runs[cols].to_csv(index=False) == two.runs[cols].to_csv(index=False)
-
-
-def test_report_names_the_rules_that_drove_the_fuzzy_example_run():
-    from xfuzzy_rrt.bench.runner import run_benchmark
-    from xfuzzy_rrt.geometry.scenario import load_scenario
-    from xfuzzy_rrt.report.bench_report import render_bench_report
-
-    s = load_scenario(TWO_CIRCLES)
-    result = run_benchmark([s], ["rrt", "fuzzy-rrt"], runs=3)
-    example = result.examples[(s.name, "fuzzy-rrt")]
+def test_report_names_the_rules_that_drove_the_fuzzy_example_run(full):
+    result, _, html = full
+    example = result.examples[("two-circles", "fuzzy-rrt")]
     assert example.trace is not None and len(example.trace) == example.iterations
-    html = render_bench_report(result, command="xfuzzy-rrt bench", generated_at="T")
     assert "Rules that drove the example Fuzzy-RRT run" in html
     assert html.count("if angle_to_goal is ") >= 6 * 3

@@ -381,7 +381,7 @@ def boxplots(runs: pd.DataFrame, scenarios: Iterable[str] | None = None,
             common = dict(name=label, legendgroup=p, marker=dict(color=color, size=5),
                           line=dict(color=color), fillcolor=_rgba(color, 0.25),
                           boxpoints="all", jitter=0.35, pointpos=0, boxmean=False)
-            fig.add_trace(go.Box(x=[label] * len(g), y=g["iterations"].to_numpy(),
+            fig.add_trace(go.Box(y=g["iterations"].to_numpy(),
                                  customdata=g["seed"].to_numpy(), showlegend=(r == 1),
                                  hovertemplate="seed %{customdata}<br>%{y} iterations"
                                                "<extra>" + label + "</extra>", **common),
@@ -395,7 +395,7 @@ def boxplots(runs: pd.DataFrame, scenarios: Iterable[str] | None = None,
                     customdata=failed["seed"].to_numpy(),
                     hovertemplate="FAILED seed %{customdata}<extra></extra>"), row=r, col=1)
             if len(ok):
-                fig.add_trace(go.Box(x=[label] * len(ok), y=ok["cost_deg"].to_numpy(),
+                fig.add_trace(go.Box(y=ok["cost_deg"].to_numpy(),
                                      customdata=ok["seed"].to_numpy(), showlegend=False,
                                      hovertemplate="seed %{customdata}<br>%{y:.1f}\u00b0"
                                                    "<extra>" + label + "</extra>", **common),
@@ -450,4 +450,23 @@ def outcome_figure(results: Mapping[str, Any], title: str | None = None) -> go.F
                       title=dict(text=title or "Outcome of each iteration (example run)", x=0.0),
                       yaxis_title="iterations", margin=dict(l=55, r=15, t=60, b=50),
                       showlegend=True)
+    return fig
+
+
+def drilldown_figure(scenario: Scenario, result, grid: CSpaceGrid | None = None) -> go.Figure:
+    """The joint-space map of a Fuzzy-RRT run for the drill-down: the page's script draws the
+    chosen iteration's sampling box (a shape) and moves the last trace -- the node the fuzzy
+    systems looked at, the sample, and the new configuration -- onto that iteration."""
+    fig = joint_space_figure(scenario, result, grid=grid,
+                             title=f"{plot_text(planner_label(result.planner))}: the chosen "
+                                   "iteration in joint space<br><sup>dashed box: sampling box; "
+                                   "circle: node expanded; x: sample; diamond: new "
+                                   "configuration</sup>")
+    fig.add_trace(go.Scatter(
+        x=[None, None, None], y=[None, None, None], mode="markers+lines", name="this iteration",
+        line=dict(color="#000000", width=1, dash="dot"),
+        marker=dict(symbol=["circle-open", "x", "diamond"], size=[14, 11, 12],
+                    color=["#000000", "#D55E00", "#009E73"], line=dict(width=2)),
+        text=["node expanded", "sample", "new configuration"],
+        hovertemplate="%{text}: (%{x:.2f}\u00b0, %{y:.2f}\u00b0)<extra></extra>"))
     return fig

@@ -3,8 +3,9 @@
 Why these rules (DESIGN.md, "Reports"):
 
 - *Offline*: an audit report must open years later on an air-gapped machine, so plotly.js is
-  embedded once in the page head and every figure is written with ``include_plotlyjs=False``;
-  no ``<script src=...>`` and no CDN.
+  embedded once in the page head; figures are JSON drawn by one loader script (see
+  :mod:`.plotjson`: compact typed arrays, shared values stored once, drawn lazily as they
+  scroll into view); no ``<script src=...>`` and no CDN.
 - *Escaped*: scenario names, descriptions, commands and paths come from user files; every piece
   of text goes through :func:`esc` before it reaches the page (figure titles too, since plotly
   renders a subset of HTML in them).
@@ -12,7 +13,7 @@ Why these rules (DESIGN.md, "Reports"):
   random UUID), so two reports of the same inputs differ only in the date line and can be
   diffed.
 
-The training and trace reports reuse :class:`Page`, :func:`figure_div` and :func:`table`.
+Other pages (rule coverage, rulebook diff) reuse :class:`Page` and :func:`table`.
 """
 
 from __future__ import annotations
@@ -47,6 +48,9 @@ table.kv td { word-break: break-all; }
 .cell { min-width: 0; border: 1px solid #eee; padding: 4px; }
 .fig { width: 100%; }
 details > summary { cursor: pointer; color: #0550ae; }
+.xf-drill { border-top: 1px solid #eee; padding-top: 6px; }
+.xf-drill h4 { margin: 6px 0 2px 0; font-size: 0.95em; }
+.xf-drill-systems table.data { font-size: 0.78em; }
 """
 
 #: Sets plotly's global config before plotly.js loads (as plotly's own full-page output does):
@@ -88,16 +92,6 @@ def fmt_num(value: Any, digits: int = 1) -> str:
     return f"{x:.{digits}f}"
 
 
-def figure_div(fig, div_id: str, height: int | None = None) -> str:
-    """A plotly figure as an HTML fragment without plotly.js, with a fixed ``div_id``."""
-    if height is not None:
-        fig.update_layout(height=height)
-    body = fig.to_html(full_html=False, include_plotlyjs=False, div_id=div_id,
-                       config={"displaylogo": False, "responsive": True},
-                       default_height=f"{fig.layout.height or 450}px")
-    return f'<div class="fig">{body}</div>'
-
-
 def table(rows: Iterable[Sequence[Any]], header: Sequence[str] | None,
           formats: Sequence[Callable[[Any], str] | None] | None = None,
           css_class: str = "data", raw_html: bool = False) -> str:
@@ -135,12 +129,19 @@ class Page:
     """Collects HTML fragments and renders one self-contained page.
 
     Fragments passed to :meth:`add` must already be escaped (use :func:`esc`); :meth:`heading`
-    and :meth:`paragraph` escape for you.
+    and :meth:`paragraph` escape for you. Figures go through :meth:`figure`: their JSON is
+    compacted and deduplicated (:mod:`.plotjson`) and drawn by one loader script at the end.
     """
 
     def __init__(self, title: str) -> None:
+        from xfuzzy_rrt.report.plotjson import SharedStore
+
         self.title = title
         self.parts: list[str] = []
+        self.shared = SharedStore()
+        self.figures: dict[str, Any] = {}
+        self.data: dict[str, Any] = {}
+        self.scripts: list[str] = []
 
     def add(self, fragment: str) -> None:
         self.parts.append(fragment)
@@ -152,10 +153,39 @@ class Page:
     def paragraph(self, text: str, css_class: str = "note") -> None:
         self.parts.append(f'<p class="{esc(css_class)}">{esc(text)}</p>')
 
+    def figure(self, fig, div_id: str, height: int | None = None) -> str:
+        """Register ``fig`` under the fixed ``div_id``; return its placeholder ``<div>``."""
+        from xfuzzy_rrt.report.plotjson import figure_spec
+
+        if div_id in self.figures:
+            raise ValueError(f"duplicate figure id {div_id!r}")
+        if height is not None:
+            fig.update_layout(height=height)
+        h = int(fig.layout.height or 450)
+        self.figures[div_id] = figure_spec(fig, self.shared)
+        return (f'<div class="fig"><div id="{esc(div_id)}" class="plotly-graph-div" '
+                f'style="height:{h}px; width:100%;"></div></div>')
+
+    def json_data(self, key: str, value: Any) -> None:
+        """Embed ``value`` as JSON (script-safe) under element id ``key``."""
+        self.data[key] = value
+
+    def script(self, js: str) -> None:
+        """Page script run after the figure loader (no user text may be interpolated here)."""
+        self.scripts.append(js)
+
     def render(self) -> str:
         """The page, with plotly.js embedded exactly once in the head."""
         from plotly.offline import get_plotlyjs
 
+        from xfuzzy_rrt.report.plotjson import LOADER_JS, script_json
+
+        blocks = [f'<script type="application/json" id="xf-shared">'
+                  f"{script_json(self.shared.values)}</script>",
+                  f'<script type="application/json" id="xf-figs">'
+                  f"{script_json(self.figures)}</script>"]
+        blocks += [f'<script type="application/json" id="{esc(k)}">{script_json(v)}</script>'
+                   for k, v in self.data.items()]
         return "".join([
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n",
             f"<title>{esc(self.title)}</title>\n",
@@ -164,5 +194,7 @@ class Page:
             '<script type="text/javascript">', get_plotlyjs(), "</script>\n",
             "</head>\n<body>\n",
             "\n".join(self.parts),
+            "\n", "\n".join(blocks),
+            "\n<script>", LOADER_JS, "\n".join(self.scripts), "</script>",
             "\n</body>\n</html>\n",
         ])

@@ -1,0 +1,202 @@
+"""The benchmark runner and its tables: recomputable, worker-independent, failures counted.
+
+A benchmark's claims ("2x fewer iterations") must be re-derivable from ``runs.csv`` alone, so
+the summary and the ratio table are recomputed here from the file on disk; runs must not depend
+on the number of workers (shortcutting and certification included); a directory argument means
+every scenario in it; the progress bar degrades to plain lines when stderr is not a terminal.
+"""
+
+from __future__ import annotations
+
+import io
+import shutil
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from conftest import FIXTURES, SHARED_SCENARIOS
+from exact_geometry import Oracle
+
+TWO_CIRCLES = FIXTURES / "scenarios" / "two-circles.toml"
+BOXES = FIXTURES / "scenarios" / "boxes-and-circle.toml"
+
+
+@pytest.fixture(scope="module")
+def scenarios():
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    return [load_scenario(TWO_CIRCLES), load_scenario(BOXES)]
+
+
+@pytest.fixture(scope="module")
+def bench_dir(tmp_path_factory, scenarios):
+    """A small benchmark with a tight budget (so some runs fail) written to disk."""
+    from xfuzzy_rrt.bench.runner import run_benchmark
+    from xfuzzy_rrt.bench.store import write_bench_dir
+
+    result = run_benchmark(scenarios, ["rrt", "fuzzy-rrt"], runs=8, seed=3, max_iter=600,
+                           shortcut=True)
+    out = tmp_path_factory.mktemp("bench")
+    write_bench_dir(result, out, {"command": "test"})
+    return result, out
+
+
+def test_summary_recomputed_from_runs_csv_matches_summary_csv(bench_dir):
+    from xfuzzy_rrt.bench.store import read_runs
+    from xfuzzy_rrt.bench.summary import ratio_table, summarise
+
+    result, out = bench_dir
+    runs = read_runs(out / "runs.csv")
+    assert not runs["success"].all(), "the budget should make some runs fail"
+    again = summarise(runs)
+    on_disk = pd.read_csv(out / "summary.csv")
+    pd.testing.assert_frame_equal(again.reset_index(drop=True), on_disk, check_dtype=False)
+    pd.testing.assert_frame_equal(ratio_table(again), pd.read_csv(out / "ratios.csv"),
+                                  check_dtype=False)
+
+
+def test_failed_runs_count_as_max_iter_and_are_never_dropped(bench_dir):
+    result, _ = bench_dir
+    runs, summary = result.runs, result.summary
+    failed = runs[~runs["success"]]
+    assert len(failed) > 0
+    assert (failed["iterations"] == 600).all()
+    for row in summary.itertuples(index=False):
+        g = runs[(runs["scenario"] == row.scenario) & (runs["planner"] == row.planner)]
+        assert row.runs == len(g) == 8
+        assert row.iterations_median == float(np.median(g["iterations"]))
+        assert row.success_rate == g["success"].mean()
+
+
+def test_our_planners_paths_are_all_certified_and_shortcuts_never_longer(bench_dir, scenarios):
+    result, _ = bench_dir
+    ok = result.runs[result.runs["success"]]
+    assert len(ok) > 0
+    assert ok["certified"].astype(bool).all()
+    assert (ok["penetration_m"] == 0.0).all()
+    assert (ok["cost_short_deg"] <= ok["cost_deg"] + 1e-9).all()
+    assert ok["cost_short_deg"].lt(ok["cost_deg"] - 1e-6).any(), "shortcutting never shortened"
+    failed = result.runs[~result.runs["success"]]
+    assert failed["certified"].isna().all() and failed["cost_short_deg"].isna().all()
+    assert (ok["time_first_s"] == ok["wall_s"]).all()
+    assert (result.summary["certified_fraction"].dropna() == 1.0).all()
+
+
+def test_ratio_table_gives_the_distribution_of_per_scenario_median_ratios(bench_dir):
+    result, _ = bench_dir
+    s = result.summary.set_index(["scenario", "planner"])["iterations_median"]
+    per = [s[(n, "rrt")] / s[(n, "fuzzy-rrt")] for n in ("two-circles", "boxes-and-circle")]
+    row = result.ratios.set_index("planner").loc["fuzzy-rrt"]
+    assert row["scenarios"] == 2
+    assert row["ratio_median"] == pytest.approx(np.median(per))
+    assert row["ratio_worst"] == pytest.approx(min(per))
+    assert row["ratio_best"] == pytest.approx(max(per))
+    fz = result.summary[result.summary["planner"] == "fuzzy-rrt"]
+    assert sorted(fz["iter_ratio_vs_rrt"]) == pytest.approx(sorted(per))
+    assert result.summary.loc[result.summary["planner"] == "rrt", "iter_ratio_vs_rrt"].eq(1.0).all()
+
+
+def test_results_do_not_depend_on_the_number_of_workers(scenarios):
+    from xfuzzy_rrt.bench.runner import run_benchmark
+
+    kw = dict(runs=4, seed=11, max_iter=2000, shortcut=True)
+    one = run_benchmark(scenarios[:1], ["rrt", "fuzzy-rrt"], workers=1, **kw)
+    two = run_benchmark(scenarios[:1], ["rrt", "fuzzy-rrt"], workers=2, **kw)
+    cols = [c for c in one.runs.columns if c not in ("wall_s", "time_first_s")]
+    assert one.runs[cols].to_csv(index=False) == two.runs[cols].to_csv(index=False)
+
+
+def test_progress_is_reported_for_every_run_in_order(scenarios):
+    from xfuzzy_rrt.bench.runner import run_benchmark
+
+    calls = []
+    run_benchmark(scenarios[:1], ["rrt"], runs=5, progress=lambda d, t: calls.append((d, t)))
+    assert calls == [(k, 5) for k in range(1, 6)]
+
+
+def test_progress_bar_writes_plain_lines_when_not_a_terminal():
+    from xfuzzy_rrt.cli.bench import ProgressBar
+
+    stream = io.StringIO()
+    bar = ProgressBar(stream)
+    for k in range(1, 101):
+        bar(k, 100)
+    lines = stream.getvalue().splitlines()
+    assert "\r" not in stream.getvalue()
+    assert lines[0] == "bench: 1/100 runs (1%)" and lines[-1] == "bench: 100/100 runs (100%)"
+    assert len(lines) == 11
+
+
+def test_unknown_or_repeated_planner_is_rejected_before_any_run(scenarios):
+    from xfuzzy_rrt.bench.runner import run_benchmark
+    from xfuzzy_rrt.errors import InputError
+
+    with pytest.raises(InputError, match="unknown planner 'rrt-star'"):
+        run_benchmark(scenarios, ["rrt", "rrt-star"], runs=1)
+    with pytest.raises(InputError, match="listed twice"):
+        run_benchmark(scenarios, ["rrt", "rrt"], runs=1)
+
+
+def test_bench_on_a_directory_runs_every_scenario_in_it(run_cli, tmp_path):
+    folder = tmp_path / "scen"
+    folder.mkdir()
+    shutil.copy(TWO_CIRCLES, folder / "a.toml")
+    shutil.copy(BOXES, folder / "b.toml")
+    (folder / "notes.txt").write_text("not a scenario")
+    out = tmp_path / "out"
+    proc = run_cli("bench", folder, "--planners", "rrt", "--runs", "2", "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    runs = pd.read_csv(out / "runs.csv")
+    assert sorted(runs["scenario"].unique()) == ["boxes-and-circle", "two-circles"]
+    assert "bench: 4/4 runs (100%)" in proc.stderr
+    for name in ("summary.csv", "ratios.csv", "bench.json", "report.html",
+                 "examples/index.json"):
+        assert (out / name).is_file(), name
+
+
+def test_bench_on_an_empty_directory_is_one_error_line(run_cli, tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    proc = run_cli("bench", empty, "--runs", "1", "--out", tmp_path / "out")
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [f"error: {empty}: directory contains no *.toml "
+                                                "scenario file"]
+    assert not (tmp_path / "out").exists()
+
+
+def test_bench_json_records_scenario_hashes_and_rulebook(bench_dir):
+    import hashlib
+    import json
+
+    _, out = bench_dir
+    meta = json.loads((out / "bench.json").read_text())
+    by_name = {e["name"]: e for e in meta["scenarios"]}
+    assert by_name["two-circles"]["sha256"] == hashlib.sha256(TWO_CIRCLES.read_bytes()).hexdigest()
+    assert by_name["two-circles"]["toml"] == TWO_CIRCLES.read_text()
+    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
+
+    assert meta["rulebook"]["sha256"] == load_rulebook(default_rulebook_path()).sha256
+    assert meta["settings"]["shortcut"] is True and meta["settings"]["max_iter"] == 600
+
+
+@pytest.mark.skipif(not (SHARED_SCENARIOS / "paper-reference.toml").is_file(),
+                    reason="shared scenarios not present")
+def test_ompl_planner_runs_beside_ours_and_its_paths_are_certified_or_flagged(tmp_path):
+    from xfuzzy_rrt.bench.runner import run_benchmark
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    path = SHARED_SCENARIOS / "paper-reference.toml"
+    result = run_benchmark([load_scenario(path)], ["rrt", "ompl:RRTConnect"], runs=3,
+                           max_iter=5000, shortcut=True)
+    oracle = Oracle(path)
+    ompl_rows = result.runs[result.runs["planner"] == "ompl:RRTConnect"]
+    assert ompl_rows["success"].any()
+    for row in ompl_rows[ompl_rows["success"]].itertuples(index=False):
+        assert row.certified in (True, False)
+        assert row.cost_short_deg <= row.cost_deg + 1e-9
+    example = result.examples[("paper-reference", "ompl:RRTConnect")]
+    problems = oracle.path_problems(example.path_deg)
+    row = ompl_rows[ompl_rows["seed"] == example.seed].iloc[0]
+    # never silently accepted: a path the oracle rejects is not certified
+    assert not problems or not bool(row["certified"])

@@ -32,11 +32,16 @@ def _register() -> None:
     from xfuzzy_rrt.cli import explain as explain_cli
     from xfuzzy_rrt.cli import plan as plan_cli
     from xfuzzy_rrt.cli import rules as rules_cli
+    from xfuzzy_rrt.cli import scenarios as scenarios_cli
+    from xfuzzy_rrt.cli import train as train_cli
 
     plan_cli.register(app)
     bench_cli.register(app)
     explain_cli.register(app)
+    __import__("xfuzzy_rrt.cli.report", fromlist=["register"]).register(app)
+    train_cli.register(app)
     app.add_typer(rules_cli.app, name="rules")
+    app.add_typer(scenarios_cli.app, name="scenarios")
 
 
 _register()
@@ -59,6 +64,10 @@ def main(argv: list[str] | None = None) -> int:
         code = 2
     except InputError as exc:
         _print_error(str(exc))
+        code = 2
+    except OSError as exc:  # an unusable path argument: --out naming a directory or a file, ...
+        where = exc.filename2 if exc.filename2 is not None else exc.filename
+        _print_error(f"{where}: {exc.strerror or exc}" if where is not None else str(exc))
         code = 2
     except typer.exceptions.TyperException as exc:  # click usage errors live under this base
         name = type(exc).__name__

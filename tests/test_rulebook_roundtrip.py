@@ -28,7 +28,9 @@ SHIPPED = list_rulebooks()
 
 
 def _files(root: Path) -> dict[str, bytes]:
-    return {p.name: p.read_bytes() for p in sorted(root.iterdir()) if p.is_file()}
+    """The rulebook's own files (a trained rulebook also keeps its history.csv beside them)."""
+    return {p.name: p.read_bytes() for p in sorted(root.iterdir())
+            if p.is_file() and (p.name == MANIFEST_NAME or p.suffix == ".fis")}
 
 
 def test_the_default_rulebook_is_shipped():

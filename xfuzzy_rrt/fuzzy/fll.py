@@ -20,6 +20,12 @@ import can restore them. :func:`import_fll` reads this subset back (terms may co
 order and shoulders may also be ``Triangle -inf lo p1`` / ``Triangle p3 hi inf``), checks that
 the terms form the Ruspini partition the engine assumes, and reports every problem with file
 and line. Export followed by import gives identical arrays.
+
+Rulebooks written in the compact layout (rules with ``any`` terms, see :mod:`.text_format`)
+export exactly like their full form: the model is always the expanded 625-constant grid, so
+the FLL files always hold 625 fully specified rules (FLL has no don't-care term that
+pyfuzzylite evaluates the same way), and a compact rulebook and its full form export to
+identical bytes.
 """
 
 from __future__ import annotations
@@ -186,7 +192,9 @@ def parse_fll(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem
             if value.startswith(_DESCRIPTION_TAG + " "):
                 try:
                     meta = json.loads(value[len(_DESCRIPTION_TAG) + 1:])
-                except json.JSONDecodeError:
+                except (json.JSONDecodeError, RecursionError):
+                    meta = {}
+                if not isinstance(meta, dict):  # only an object carries name, mode, sha256
                     meta = {}
         elif section == "var" and key == "term":
             parts = value.split()
@@ -397,8 +405,11 @@ def import_fll(
         provenance["command"] = command
     if meta.get("sha256"):
         provenance["source_sha256"] = str(meta["sha256"])
+    meta_name = meta.get("name")
+    if not isinstance(meta_name, str) or not meta_name.strip():
+        meta_name = None  # a blank or non-text name in a hand-edited export: fall back
     return Rulebook(
-        name=name or str(meta.get("name") or root.resolve().name),
+        name=name or meta_name or root.resolve().name,
         bounds_mode=mode,
         systems=tuple(systems),
         provenance=provenance,

@@ -24,7 +24,7 @@ from xfuzzy_rrt.fuzzy.variables import (
 #: Term names are identifiers (letters, digits, underscores; not starting with a digit) and
 #: cannot be one of the words the rule grammar uses.
 TERM_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
-RESERVED = frozenset({"if", "is", "and", "then", "or", "not"})
+RESERVED = frozenset({"if", "is", "and", "then", "or", "not", "any"})  # any: don't-care
 
 
 def term_name_problem(name: str) -> str | None:

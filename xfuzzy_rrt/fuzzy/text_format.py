@@ -39,7 +39,24 @@ indentation is free; ``\\r\\n`` and a UTF-8 BOM are tolerated):
   one per antecedent, 625 in all. The ``rN:`` label is optional when reading but, if present,
   must be the rule's index ``((t0*5 + t1)*5 + t2)*5 + t3``; the four inputs may appear in any
   order. VALUE must lie within the output range.
+- ``TERM`` may be ``any`` (a don't-care: every term of that input), e.g.
+  ``if angle_to_goal is north and dist_to_goal is near and angle_to_obstacle is any and
+  dist_to_obstacle is any then goal_bias = 0.6`` stands for the 25 rules it covers. A rule with
+  ``any`` carries no ``rN:`` label (it has no single index). After expanding ``any``, the rules
+  must cover each of the 625 cells exactly once: a cell covered twice is reported on the later
+  rule's line naming the earlier rule's line; an uncovered region is reported as the patterns
+  nobody covers, naming the rules on either side of it (in index order). ``any`` is therefore
+  reserved and cannot be a term name. The model is always the full 625-constant grid; ``any``
+  exists only in the text.
 - ``end`` — must close the file (so that a truncated file is recognised as such).
+
+Compact layout (``format_fis(..., compact=True)``, written by ``rules simplify``): the same
+header and inputs, then the fewest rules with ``any`` that reproduce the 625 constants exactly
+(:func:`~xfuzzy_rrt.fuzzy.cover.min_partition`), ordered by the first cell each covers;
+single-cell rules keep their ``rN:`` label. A compact file reads back to the same constants, and
+writing it compact again gives identical bytes. The *default* canonical layout stays the full
+625-rule form, and ``Rulebook.sha256`` is always computed over the full form, so a rulebook's
+identity does not depend on the layout it is stored in.
 
 Comments on save: saving writes the *canonical* layout — the fixed comment header, one
 ``# <input 0> is ..., <input 1> is ...`` comment above each block of 25 rules, rules in index
@@ -59,6 +76,7 @@ import math
 import re
 from dataclasses import dataclass, field
 
+from xfuzzy_rrt.fuzzy.cover import ANY, ANY_WORD, greedy_gap_patterns, pattern_cells
 from xfuzzy_rrt.fuzzy.system import (
     FuzzySystem,
     InputPartition,
@@ -131,10 +149,27 @@ def rule_sentence(fis: FuzzySystem, r: int) -> str:
     return f"if {ante} then {fis.output} = {fnum(fis.consts[r])}"
 
 
-def format_fis(fis: FuzzySystem) -> str:
-    """The canonical text of *fis* (``\\n`` line ends, trailing newline)."""
+def pattern_sentence(fis: FuzzySystem, pattern, value: float) -> str:
+    """A rule with don't-care terms (``-1`` in *pattern*) as the sentence the format writes."""
+    ante = " and ".join(
+        f"{inp.name} is {ANY_WORD if pattern[i] == ANY else inp.terms[pattern[i]]}"
+        for i, inp in enumerate(fis.inputs))
+    return f"if {ante} then {fis.output} = {fnum(value)}"
+
+
+def format_fis(fis: FuzzySystem, compact: bool = False) -> str:
+    """The canonical text of *fis* (``\\n`` line ends, trailing newline).
+
+    ``compact=True`` writes the fewest rules with ``any`` terms that expand to exactly the same
+    625 constants (see the module docstring).
+    """
     lo, hi = fis.range
     lines = header_comment(fis.output)
+    if compact:
+        lines += [
+            "# Compact layout: 'INPUT is any' matches every term of that input; after expanding",
+            "# 'any' the rules cover each of the 625 cells exactly once (rN labels: single cells).",
+        ]
     lines.append(f"format {FORMAT_NAME} {FORMAT_VERSION}")
     lines.append(f"output {fis.output} range {fnum(lo)} {fnum(hi)}")
     lines.append("")
@@ -143,6 +178,17 @@ def format_fis(fis: FuzzySystem) -> str:
         lines.append(f"input {inp.name} range {fnum(ilo)} {fnum(ihi)}")
         lines.append("  terms " + " ".join(inp.terms))
         lines.append("  peaks " + " ".join(fnum(p) for p in inp.peaks))
+    if compact:
+        from xfuzzy_rrt.fuzzy.cover import min_partition
+
+        part = min_partition(fis.consts)
+        lines.append("")
+        lines.append(f"# {len(part)} rules")
+        for pattern, value in part.rules:
+            label = "" if ANY in pattern else f"r{rule_index(pattern)}: "
+            lines.append(label + pattern_sentence(fis, pattern, value))
+        lines.append("end")
+        return "\n".join(lines) + "\n"
     names = [inp.name for inp in fis.inputs]
     terms = [inp.terms for inp in fis.inputs]
     block = N_TERMS * N_TERMS
@@ -179,6 +225,7 @@ class _State:
     output_ok: bool = False
     inputs: list[_InputDecl] = field(default_factory=list)
     rules: dict[int, tuple[int, float]] = field(default_factory=dict)  # r -> (line, value)
+    saw_any: bool = False  # a rule used 'any': gaps are described as patterns
     # labels of rule lines that were reported as broken: not reported again as "missing"
     attempted: set[int] = field(default_factory=set)
     end_line: int | None = None
@@ -399,6 +446,9 @@ def _rule(st: _State, n: int, text: str) -> None:
             ok = False  # the input's own declaration is already reported (or missing: reported at the end)
             continue
         term = by_var[var]
+        if term == ANY_WORD:
+            t_idx.append(ANY)
+            continue
         if term not in decl.terms:
             st.problem(n, f"unknown term {term!r} for {var} (terms: {' '.join(decl.terms)})")
             ok = False
@@ -415,15 +465,50 @@ def _rule(st: _State, n: int, text: str) -> None:
         st.problem(n, f"consequent {m.group('value')} outside the output range [{fnum(lo)}, {fnum(hi)}] of {st.expected_output}")
     if not ok or len(t_idx) != len(INPUTS):
         return
-    r = rule_index(t_idx)
     label = m.group("label")
+    if ANY in t_idx:
+        _any_rule(st, n, tuple(t_idx), label, value)
+        return
+    r = rule_index(t_idx)
     if label is not None and int(label) != r:
         st.problem(n, f"rule label r{label} does not match its conditions (they make rule r{r})")
         return
     if r in st.rules:
-        st.problem(n, f"duplicate rule r{r}: same conditions as line {st.rules[r][0]}")
+        first = st.rules[r][0]
+        if st.saw_any:
+            st.problem(n, f"rule r{r} overlaps the rule on line {first} (which already covers it)")
+        else:
+            st.problem(n, f"duplicate rule r{r}: same conditions as line {first}")
         return
     st.rules[r] = (n, value if value is not None else math.nan)
+
+
+def _any_rule(st: _State, n: int, pattern: tuple[int, ...], label: str | None,
+              value: float | None) -> None:
+    """Expand a rule with ``any`` terms onto its cells; report overlaps once per earlier rule."""
+    st.saw_any = True
+    if label is not None:
+        st.problem(n, f"a rule with 'any' covers several cells and takes no label (drop 'r{label}:')")
+        return
+    cells = pattern_cells(pattern)
+    clashes: dict[int, list[int]] = {}
+    for r in cells.tolist():
+        if r in st.rules:
+            clashes.setdefault(st.rules[r][0], []).append(r)
+    for line, rs in sorted(clashes.items()):
+        st.problem(n, f"rule overlaps the rule on line {line} at {len(rs)} cell(s) "
+                      f"(first r{rs[0]}: {_cell_text(st, rs[0])})")
+    if clashes:
+        return
+    v = value if value is not None else math.nan
+    for r in cells.tolist():
+        st.rules[r] = (n, v)
+
+
+def _cell_text(st: _State, r: int) -> str:
+    t = rule_terms(r)
+    decls = st.inputs[: len(INPUTS)]
+    return " and ".join(f"{d.name} is {d.terms[t[k]]}" for k, d in enumerate(decls))
 
 
 def _finish(st: _State, n_lines: int, last_line: int) -> None:
@@ -456,6 +541,9 @@ def _report_missing_rules(st: _State, at_end: int) -> None:
     missing = [r for r in range(N_RULES) if r not in st.rules and r not in st.attempted]
     if not missing:
         return
+    if st.saw_any:
+        _report_gaps(st, present, missing, at_end)
+        return
     runs: list[tuple[int, int]] = []
     start = prev = missing[0]
     for r in missing[1:]:
@@ -475,6 +563,33 @@ def _report_missing_rules(st: _State, at_end: int) -> None:
             st.problem(line, f"missing rule r{a}: if {ante}")
         else:
             st.problem(line, f"missing rules r{a}..r{b} ({b - a + 1} rules)")
+
+
+def _report_gaps(st: _State, present: list[int], missing: list[int], at_end: int) -> None:
+    """Gaps in a file that uses ``any``: each uncovered region as a pattern, reported on the
+    line of the rule that follows it in index order and naming the rule before it."""
+    mask = [False] * N_RULES
+    for r in missing:
+        mask[r] = True
+    decls = st.inputs[: len(INPUTS)]
+    for pattern in greedy_gap_patterns(mask):
+        cells = pattern_cells(pattern)
+        a, b = int(cells[0]), int(cells[-1])
+        i = bisect.bisect_right(present, b)
+        after = st.rules[present[i]][0] if i < len(present) else None
+        j = bisect.bisect_left(present, a) - 1
+        before = st.rules[present[j]][0] if j >= 0 else None
+        ante = " and ".join(
+            f"{d.name} is {ANY_WORD if pattern[k] == ANY else d.terms[pattern[k]]}"
+            for k, d in enumerate(decls))
+        where = []
+        if before is not None:
+            where.append(f"after the rule on line {before}")
+        if after is not None:
+            where.append(f"before the rule on line {after}")
+        line = after if after is not None else (st.end_line or at_end)
+        st.problem(line, f"gap: no rule covers {len(cells)} cell(s) 'if {ante}' "
+                         f"({', '.join(where) or 'no rules at all'})")
 
 
 def _build(st: _State) -> FuzzySystem:

@@ -203,13 +203,14 @@ class _TraceBuffers:
 
 
 def _resolve_rulebook(rulebook):
-    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
+    """A loaded rulebook as given, else the (cached) directory or shipped default."""
+    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook_cached
 
     if rulebook is None:
         rulebook = default_rulebook_path()
-    if hasattr(rulebook, "arrays"):
+    if hasattr(rulebook, "compiled"):
         return rulebook
-    return load_rulebook(rulebook)
+    return load_rulebook_cached(rulebook)
 
 
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,
@@ -224,7 +225,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     check_planar_2dof(scenario)
     check_max_iter(max_iter)
     rb = _resolve_rulebook(rulebook)
-    knots, consts = rb.arrays()
+    knots, consts = rb.compiled
     mode = BOUNDS_RELATIVE if rb.bounds_mode == "relative" else BOUNDS_ABSOLUTE
     a = scenario.arrays()
     tree = Tree(int(max_iter) + 2, a.limits_deg)

@@ -293,3 +293,16 @@ def test_default_rulebook_is_parsed_once_while_unchanged(tmp_path, monkeypatch):
     fis.write_text(text)
     plan_fuzzy_rrt(s, tmp_path / "rb", seed=1)
     assert len(calls) == 2  # an edited file is re-read
+
+
+def test_resuming_a_finished_run_with_more_generations_equals_the_longer_run(tmp_path):
+    (tmp_path / "long").mkdir()
+    assert _train(tmp_path / "long", "--workers", "1", "--generations", "4").returncode == 0
+    (tmp_path / "extended").mkdir()
+    assert _train(tmp_path / "extended", "--workers", "1", "--generations", "2").returncode == 0
+    more = _train(tmp_path / "extended", "--workers", "1", "--generations", "4", "--resume")
+    assert more.returncode == 0, more.stderr
+    long_files, long_history = _outputs(tmp_path / "long" / "rb")
+    files, history = _outputs(tmp_path / "extended" / "rb")
+    assert files == long_files
+    pd.testing.assert_frame_equal(history, long_history)

@@ -95,7 +95,7 @@ def train(
         scenarios=tuple((t.scenario.name, t.sha256) for t in scenarios),
     )
     job = TrainJob(config=config, scenarios=scenarios, out=out, resume=resume, workers=workers,
-                   scheduler=scheduler, name=name)
+                   scheduler=scheduler, name=name, scenario_args=[str(p) for p in scenario])
     progress = _Progress(generations)
     try:
         result = run_training(job, on_start=progress.start, on_generation=progress.generation,

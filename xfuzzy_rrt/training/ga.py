@@ -102,9 +102,15 @@ class GAConfig:
         need(0 <= self.validation_runs <= 10_000, "--validation-runs", "must lie in [0, 10000]")
         need(len(self.scenarios) >= 1, "--scenario", "give at least one training scenario")
 
+    #: Options that only say when to stop or how to choose at the end: a checkpoint may be
+    #: resumed with other values (e.g. more generations), and the result is then exactly that
+    #: of a run asked for with those values from the start.
+    STOPPING = ("generations", "target_fitness", "validation_runs")
+
     def fingerprint(self) -> str:
-        """SHA-256 of the canonical JSON of this configuration (identifies a checkpoint's run)."""
-        blob = json.dumps(asdict(self), sort_keys=True, separators=(",", ":"))
+        """SHA-256 of the options that shape the search (identifies a checkpoint's run)."""
+        fields = {k: v for k, v in asdict(self).items() if k not in self.STOPPING}
+        blob = json.dumps(fields, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -322,9 +328,29 @@ class Trainer:
         return new
 
     def run(self, state: TrainState) -> TrainState:
+        state = self.extend(state)
         while not state.done:
             state = self.step(state)
         return state
+
+    def extend(self, state: TrainState) -> TrainState:
+        """Reopen a finished run when the stopping options now allow more generations.
+
+        A finished run skipped breeding after its last generation, so breeding now (with the
+        generator state saved then) continues exactly as an uninterrupted longer run would.
+        """
+        c = self.config
+        if not state.done or state.last_fitness is None:
+            return state
+        if state.generation >= c.generations or state.history[-1]["best_fitness"] >= c.target_fitness:
+            return state
+        rng = np.random.Generator(np.random.PCG64())
+        rng.bit_generator.state = state.rng_state
+        pop = breed(state.last_population, state.last_fitness, c, rng)
+        return TrainState(generation=state.generation, population=pop,
+                          rng_state=rng.bit_generator.state, history=state.history,
+                          hall_of_fame=state.hall_of_fame, last_fitness=state.last_fitness,
+                          last_population=state.last_population, done=False)
 
     def choose(self, state: TrainState, top: int = 5) -> TrainResult:
         """Re-evaluate the hall of fame and the final top individuals on validation seeds."""

@@ -71,11 +71,15 @@ def load_training_scenarios(paths: list[Path]) -> list[TrainingScenario]:
     return items
 
 
-def canonical_command(config: GAConfig, scenarios: list[TrainingScenario], out: str) -> str:
-    """The command that reproduces this training run (independent of workers and engine)."""
+def canonical_command(config: GAConfig, scenario_args: list[str], out: str) -> str:
+    """The command that reproduces this training run (independent of workers and engine).
+
+    ``scenario_args`` are the ``--scenario`` values as given (a folder stays a folder; the
+    manifest lists every file it held with its SHA-256).
+    """
     args = ["xfuzzy-rrt", "train"]
-    for t in scenarios:
-        args += ["--scenario", t.path]
+    for a in scenario_args:
+        args += ["--scenario", a]
     defaults = GAConfig(scenarios=(("x", "y"),))
     options = [("population", "--population"), ("generations", "--generations"),
                ("runs_per_eval", "--runs-per-eval"), ("target_fitness", "--target-fitness"),
@@ -114,6 +118,7 @@ class TrainJob:
     config: GAConfig
     scenarios: list[TrainingScenario]
     out: Path
+    scenario_args: list[str] = field(default_factory=list)  # --scenario values as given
     resume: bool = False
     workers: int | None = None
     scheduler: str | None = None
@@ -204,7 +209,8 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
     name = job.name or job.out.name or "trained"
     provenance = {
         "kind": "ga",
-        "command": canonical_command(c, job.scenarios, str(job.out)),
+        "command": canonical_command(c, job.scenario_args or [t.path for t in job.scenarios],
+                                     str(job.out)),
         "algorithm": "generational GA: tournament selection, SBX crossover, polynomial and "
                      "term-block mutation, elitism (xfuzzy_rrt.training)",
         "package_version": __version__,

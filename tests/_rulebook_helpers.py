@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
-from xfuzzy_rrt.fuzzy.rulebook import Rulebook, default_rulebook_path
+from xfuzzy_rrt.fuzzy.rulebook import Rulebook, rulebooks_dir
 from xfuzzy_rrt.fuzzy.variables import INPUT_RANGES, INPUTS, N_RULES, OUTPUT_RANGES, OUTPUTS
 
-EXPERT = default_rulebook_path()
+EXPERT = rulebooks_dir() / "expert"
 
 
 def copy_expert(tmp_path: Path, name: str = "rb") -> Path:

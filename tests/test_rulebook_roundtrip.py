@@ -156,8 +156,8 @@ def test_save_keeps_unrelated_files(tmp_path):
 
 
 def test_env_var_overrides_the_rulebooks_folder(tmp_path, monkeypatch):
-    copy_expert(tmp_path, "expert")
+    copy_expert(tmp_path, "general")
     copy_expert(tmp_path, "other")
     monkeypatch.setenv("XFUZZY_RRT_RULEBOOKS", str(tmp_path))
-    assert default_rulebook_path() == tmp_path / "expert"
-    assert [p.name for p in list_rulebooks()] == ["expert", "other"]
+    assert default_rulebook_path() == tmp_path / "general"
+    assert [p.name for p in list_rulebooks()] == ["general", "other"]

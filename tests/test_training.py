@@ -306,3 +306,31 @@ def test_resuming_a_finished_run_with_more_generations_equals_the_longer_run(tmp
     files, history = _outputs(tmp_path / "extended" / "rb")
     assert files == long_files
     pd.testing.assert_frame_equal(history, long_history)
+
+
+def test_every_damaged_checkpoint_byte_is_caught_or_harmless(tmp_path):
+    from xfuzzy_rrt.errors import InputError
+    from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
+    from xfuzzy_rrt.training.ga import new_state
+
+    config = GAConfig(population=4, elite=1, scenarios=(("a", "b"),))
+    state = new_state(config)
+    save_checkpoint(tmp_path, state, config)
+    path = tmp_path / "state.npz"
+    good = path.read_bytes()
+    rng = np.random.default_rng(0)
+    for k in range(300):
+        data = bytearray(good)
+        if k % 3 == 0:
+            data = data[: int(rng.integers(len(data)))]
+        else:
+            i = int(rng.integers(len(data)))
+            data[i] ^= int(rng.integers(1, 256))
+        path.write_bytes(bytes(data))
+        try:
+            loaded = load_checkpoint(tmp_path, config)
+        except InputError as exc:
+            assert str(exc).startswith(str(path))
+        else:  # the damage hit bytes nothing reads (e.g. zip comments): same state
+            assert np.array_equal(loaded.population, state.population)
+            assert loaded.rng_state == state.rng_state

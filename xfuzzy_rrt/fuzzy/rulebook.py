@@ -58,7 +58,9 @@ from xfuzzy_rrt.fuzzy.variables import (
 
 #: Environment variable naming a folder of rulebooks that replaces the shipped one.
 RULEBOOKS_ENV = "XFUZZY_RRT_RULEBOOKS"
-DEFAULT_RULEBOOK = "expert"
+#: The default of plan, bench and demo: the shipped rulebook that is best on problems it has never
+#: seen (measured against ``expert`` on generated problems; see rulebooks/README.md).
+DEFAULT_RULEBOOK = "general"
 
 __all__ = [
     "FuzzySystem",
@@ -230,7 +232,7 @@ def rulebooks_dir() -> Path:
 
 
 def default_rulebook_path() -> Path:
-    """Directory of the default rulebook (``expert``; hand-written until training exists)."""
+    """Directory of the default rulebook (``general``: trained on generated problems only)."""
     return rulebooks_dir() / DEFAULT_RULEBOOK
 
 

@@ -110,14 +110,23 @@ def demo(
 ) -> int:
     """Benchmark RRT vs the trained Fuzzy-RRT and write the reports.
 
-    The default rulebook (``general``, trained on generated problems only) on the shipped demo
-    scenarios, into OUT; and, when the shared reference problem sits beside the project, the
-    ``paper`` rulebook (the paper's setting) on it, into OUT/paper-reference.
+    The default rulebook (``general``, trained on generated problems only) on 24 fresh
+    problems of the ``sample-*`` family that no training run saw (generator seed 2000; the
+    files are written to OUT/scenarios), into OUT; and, when the shared reference problem sits
+    beside the project, the ``paper`` rulebook (the paper's setting) on it, into
+    OUT/paper-reference.
     """
-    from xfuzzy_rrt.bench.runner import shipped_scenarios
+    from xfuzzy_rrt.atomic import write_text_atomic
     from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+    from xfuzzy_rrt.scenarios.generate import generate_one
 
-    code = _run(shipped_scenarios(), "rrt,fuzzy-rrt", runs, 0, None, 10_000, out, workers)
+    files = []
+    for k in range(24):
+        problem = generate_one(2000, k)
+        path = out / "scenarios" / f"{problem.scenario.name}.toml"
+        write_text_atomic(path, problem.text)
+        files.append(path)
+    code = _run(files, "rrt,fuzzy-rrt", runs, 0, None, 10_000, out, workers)
     reference = rulebooks_dir().parent.parent / "shared" / "scenarios" / "paper-reference.toml"
     paper = rulebooks_dir() / "paper"
     if reference.is_file() and paper.is_dir():

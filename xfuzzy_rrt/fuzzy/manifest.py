@@ -218,6 +218,8 @@ def parse_manifest(data: bytes, file: str) -> tuple[Manifest | None, list[Proble
         return None, [(file, line, f"not valid UTF-8 (byte 0x{data[exc.start]:02x})")]
     try:
         doc = tomllib.loads(text)
+    except RecursionError:  # tomllib recurses per nesting level: "[[[[...]]]]" would crash it
+        return None, [(file, None, "not valid TOML: arrays or tables nested too deeply")]
     except tomllib.TOMLDecodeError as exc:
         msg = str(exc)
         m = re.search(r"\(at line (\d+), column \d+\)", msg)

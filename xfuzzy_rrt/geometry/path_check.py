@@ -41,6 +41,7 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.collision import (
     CERT_MARGIN_M,
     edge_free,
+    link_motion_bound,
     segment_obstacle_dist,
     within_limits,
 )
@@ -137,12 +138,7 @@ def motion_bound(links, qa_deg, qb_deg):
     """
     best = 0.0
     for k in range(links.shape[0]):
-        mk = 0.0
-        for j in range(k + 1):
-            tail = 0.0
-            for i in range(j, k + 1):
-                tail += links[i]
-            mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail
+        mk = link_motion_bound(links, qa_deg, qb_deg, k)
         if mk > best:
             best = mk
     return best

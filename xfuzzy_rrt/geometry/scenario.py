@@ -26,6 +26,12 @@ from xfuzzy_rrt.errors import ScenarioError
 CIRCLE = 0
 BOX = 1
 
+#: Largest length or coordinate (metres) a scenario may use. Beyond ~1e154 m the squared
+#: distances overflow to inf and the certified check would step over obstacles; long before
+#: that, float64 rounding outgrows the 1 µm certification margin. 1e6 m keeps rounding errors
+#: below 1e-9 m while allowing any plausible unit mistake (millimetres for metres).
+MAX_EXTENT_M = 1e6
+
 
 @dataclass(frozen=True)
 class Circle:
@@ -143,10 +149,25 @@ class _Reader:
     def number(self, value: Any, path: str) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.fail(path, f"must be a number, got {_typename(value)}")
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:  # a TOML integer has no size limit
+            raise self.fail(path, "must be finite, got an integer too large for a float") from None
         if not math.isfinite(x):
             raise self.fail(path, f"must be finite, got {value}")
         return x
+
+    def extent(self, value: float, path: str) -> float:
+        """A length or coordinate in metres: also within ``±MAX_EXTENT_M``."""
+        if abs(value) > MAX_EXTENT_M:
+            raise self.fail(path, f"must lie within ±{MAX_EXTENT_M:g} m (larger geometry cannot "
+                            f"be certified in float64), got {value:g}")
+        return value
+
+    def lengths(self, value: Any, path: str, length: int | None = None) -> tuple[float, ...]:
+        """:meth:`numbers` that are lengths or coordinates in metres (see :meth:`extent`)."""
+        values = self.numbers(value, path, length)
+        return tuple(self.extent(v, f"{path}[{i}]") for i, v in enumerate(values))
 
     def numbers(self, value: Any, path: str, length: int | None = None) -> tuple[float, ...]:
         if not isinstance(value, list):
@@ -186,6 +207,8 @@ def load_scenario(path: str | Path) -> Scenario:
         raise ScenarioError(file, "", f"not valid UTF-8 (byte {exc.start})") from None
     try:
         data = tomllib.loads(text)
+    except RecursionError:  # tomllib recurses per nesting level: "[[[[...]]]]" would crash it
+        raise ScenarioError(file, "", "TOML syntax error: arrays or tables nested too deeply") from None
     except tomllib.TOMLDecodeError as exc:
         message = str(exc)
         m = re.search(r"\(at line (\d+), column (\d+)\)", message)
@@ -212,14 +235,15 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenar
     arm_t = r.table(data, "arm", "arm")
     unknown += [f"arm.{k}" for k in arm_t if k not in _ARM_KEYS]
     links_raw = r.required(arm_t, "links", "arm.links")
-    links = r.numbers(links_raw, "arm.links")
+    links = r.lengths(links_raw, "arm.links")
     if not links:
         raise r.fail("arm.links", "must list at least one link length")
     for i, length in enumerate(links):
         if length <= 0:
             raise r.fail(f"arm.links[{i}]", f"link length must be > 0, got {length:g}")
-    base = r.numbers(arm_t.get("base", [0.0, 0.0]), "arm.base", length=2)
-    link_radius = r.number(arm_t.get("link_radius", 0.0), "arm.link_radius")
+    base = r.lengths(arm_t.get("base", [0.0, 0.0]), "arm.base", length=2)
+    link_radius = r.extent(r.number(arm_t.get("link_radius", 0.0), "arm.link_radius"),
+                           "arm.link_radius")
     if link_radius < 0:
         raise r.fail("arm.link_radius", f"must be >= 0, got {link_radius:g}")
     dof = len(links)
@@ -263,15 +287,16 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenar
         kind = r.required(o, "type", f"{key}.type")
         if kind == "circle":
             unknown += [f"{key}.{k}" for k in o if k not in _CIRCLE_KEYS]
-            center = r.numbers(r.required(o, "center", f"{key}.center"), f"{key}.center", 2)
-            radius = r.number(r.required(o, "radius", f"{key}.radius"), f"{key}.radius")
+            center = r.lengths(r.required(o, "center", f"{key}.center"), f"{key}.center", 2)
+            radius = r.extent(r.number(r.required(o, "radius", f"{key}.radius"), f"{key}.radius"),
+                              f"{key}.radius")
             if radius <= 0:
                 raise r.fail(f"{key}.radius", f"must be > 0, got {radius:g}")
             obstacles.append(Circle(center=(center[0], center[1]), radius=radius))
         elif kind == "box":
             unknown += [f"{key}.{k}" for k in o if k not in _BOX_KEYS]
-            lo = r.numbers(r.required(o, "min", f"{key}.min"), f"{key}.min", 2)
-            hi = r.numbers(r.required(o, "max", f"{key}.max"), f"{key}.max", 2)
+            lo = r.lengths(r.required(o, "min", f"{key}.min"), f"{key}.min", 2)
+            hi = r.lengths(r.required(o, "max", f"{key}.max"), f"{key}.max", 2)
             for axis, name_ in ((0, "x"), (1, "y")):
                 if not hi[axis] > lo[axis]:
                     raise r.fail(f"{key}.max", f"must exceed min on the {name_} axis, got "

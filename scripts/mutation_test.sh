@@ -1,0 +1,170 @@
+#!/usr/bin/env bash
+# Mutation testing of the safety core (issue 11), on a throw-away copy of the tree.
+#
+# What is mutated: xfuzzy_rrt/geometry/collision.py and geometry/kinematics.py (all of them),
+# planners/extend.py, and the path bookkeeping: tree.add_node, tree.extract_path and
+# result.path_cost_deg. Which tests judge: tests/test_safety_bounds.py, test_collision.py and
+# test_kinematics.py (override with MUTATION_TESTS="tests/a.py tests/b.py").
+#
+# Why a copy: mutmut 3 writes its instrumented sources into ./mutants/ of the directory it runs
+# in, and mutmut skips decorated functions, i.e. every numba kernel. So the script copies the
+# tree to a fresh directory, removes the `@nb.njit(...)` lines of the files under test there
+# (the kernels run as plain Python anyway with NUMBA_DISABLE_JIT=1, so behaviour is unchanged),
+# writes mutmut's [tool.mutmut] section into the *copy's* pyproject.toml and runs mutmut there.
+# Nothing in the source tree is touched.
+#
+# Usage:   scripts/mutation_test.sh [WORKDIR]          (default: a new /tmp/xfuzzy-mutation.*)
+#          scripts/mutation_test.sh --weaken F [WORKDIR]
+#            instead of mutmut: make the certified check F times non-conservative in the copy
+#            (a) the motion bound divided by F, (b) the advance multiplied by F; run the safety
+#            tests (numba on) against each and print the failures. Exit 0 only when the suite
+#            fails for both, i.e. the weakening is caught. Try F = 1.05.
+# Env:     PYTHON (default .venv/bin/python), MUTATION_JOBS (default 1), MUTATION_TESTS,
+#          MUTATION_MUTANTS (mutant name globs, default: the safety core as above).
+# Needs:   mutmut >= 3.8 in that interpreter (.venv/bin/pip install mutmut).
+# Output:  every surviving mutant with its diff, and a last line
+#          "mutation score: K killed / N mutants = P %  (survived S, timeout T, other O)".
+#          Exit status 0 when every mutant was killed, 1 otherwise.
+set -euo pipefail
+
+WEAKEN=""
+if [ "${1:-}" = "--weaken" ]; then
+  WEAKEN=${2:?--weaken needs a factor, e.g. 1.05}
+  shift 2
+fi
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+PY=${PYTHON:-$ROOT/.venv/bin/python}
+MUTMUT=$(dirname "$PY")/mutmut
+JOBS=${MUTATION_JOBS:-1}
+WORK=${1:-$(mktemp -d /tmp/xfuzzy-mutation.XXXXXX)}
+TESTS=${MUTATION_TESTS:-tests/test_safety_bounds.py tests/test_collision.py tests/test_kinematics.py}
+MUTANTS=${MUTATION_MUTANTS:-"xfuzzy_rrt.geometry.collision.* xfuzzy_rrt.geometry.kinematics.* xfuzzy_rrt.planners.extend.* xfuzzy_rrt.planners.tree.x_add_node__mutmut_* xfuzzy_rrt.planners.tree.x_extract_path__mutmut_* xfuzzy_rrt.planners.result.x_path_cost_deg__mutmut_*"}
+FILES=(xfuzzy_rrt/geometry/collision.py xfuzzy_rrt/geometry/kinematics.py
+       xfuzzy_rrt/planners/extend.py xfuzzy_rrt/planners/tree.py xfuzzy_rrt/planners/result.py)
+
+[ -n "$WEAKEN" ] || [ -x "$MUTMUT" ] || { echo "error: $MUTMUT not found; run: $(dirname "$PY")/pip install mutmut" >&2; exit 2; }
+case "$(cd "$WORK" 2>/dev/null && pwd || echo "$WORK")" in
+  "$ROOT"|"$ROOT"/*) echo "error: the work directory must be outside $ROOT" >&2; exit 2 ;;
+esac
+mkdir -p "$WORK"
+
+echo "copying $ROOT -> $WORK"
+tar -C "$ROOT" --exclude=./.venv --exclude=./.git --exclude=./mutants --exclude=./reports \
+    --exclude=__pycache__ --exclude='*.nbi' --exclude='*.nbc' --exclude=.hypothesis \
+    --exclude=.pytest_cache -cf - . | tar -C "$WORK" -xf -
+# tests/conftest.py finds the shared scenarios at <project>/../shared; mutmut's project is
+# WORK/mutants, so WORK/shared must point at them.
+if [ -d "$ROOT/../shared" ] && [ ! -e "$WORK/shared" ]; then
+  ln -s "$(cd "$ROOT/../shared" && pwd)" "$WORK/shared"
+fi
+
+cd "$WORK"
+if [ -n "$WEAKEN" ]; then
+  status=0
+  for variant in bound advance; do
+    cp "$ROOT/xfuzzy_rrt/geometry/collision.py" xfuzzy_rrt/geometry/collision.py
+    "$PY" - "$variant" "$WEAKEN" <<'PYEOF'
+"""Weaken the certified check in the copy: the bound M_k / F, or the advance ds * F."""
+import sys
+from pathlib import Path
+
+variant, factor = sys.argv[1], sys.argv[2]
+path = Path("xfuzzy_rrt/geometry/collision.py")
+text = path.read_text()
+old, new = {
+    "bound": ("        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk\n",
+              f"        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk / {factor}\n"),
+    "advance": ("                step = ck / mk\n", f"                step = ck / mk * {factor}\n"),
+}[variant]
+if text.count(old) != 1:
+    sys.exit(f"error: cannot find the {variant} code to weaken in {path}")
+path.write_text(text.replace(old, new))
+PYEOF
+    echo "== $variant weakened by a factor $WEAKEN:"
+    if PYTHONPATH="$WORK" nice -n 10 "$PY" -m pytest -q -p no:cacheprovider \
+        tests/test_safety_bounds.py tests/test_collision.py > weaken-$variant.log 2>&1; then
+      echo "NOT CAUGHT: the suite passes with the $variant weakened by $WEAKEN"
+      status=1
+    else
+      grep -E "^FAILED|AssertionError: link|passed|failed" weaken-$variant.log | cut -c1-200
+      echo "caught: the suite fails (log: $WORK/weaken-$variant.log)"
+    fi
+  done
+  exit $status
+fi
+"$PY" - "${FILES[@]}" <<'EOF'
+"""Drop the numba decorators of the files under test (mutmut skips decorated functions)."""
+import re
+import sys
+from pathlib import Path
+
+for name in sys.argv[1:]:
+    path = Path(name)
+    text = path.read_text()
+    new, n = re.subn(r"(?m)^@nb\.njit\([^)]*\)\n", "", text)
+    if n == 0 and "@nb.njit" in text:
+        sys.exit(f"error: could not strip the numba decorators of {name}")
+    path.write_text(new)
+    print(f"  {name}: {n} numba decorators removed")
+EOF
+
+"$PY" - "$TESTS" "${FILES[@]}" <<'EOF'
+"""Append the [tool.mutmut] section to the copy's pyproject.toml."""
+import json
+import sys
+from pathlib import Path
+
+tests = sys.argv[1].split()
+files = sys.argv[2:]
+section = "\n".join([
+    "",
+    "[tool.mutmut]",
+    'source_paths = ["xfuzzy_rrt"]',
+    f"only_mutate = {json.dumps(files)}",
+    f"pytest_add_cli_args_test_selection = {json.dumps(tests)}",
+    'pytest_add_cli_args = ["-p", "no:cacheprovider", "-p", "no:randomly", "--hypothesis-seed=0", "-q"]',
+    "use_git_change_detection = false",
+    # A mutant that never lets the advancement reach s = 1 hangs: give up after 5x the clean
+    # run's time (counted as detected, see below) rather than mutmut's default 15x.
+    "timeout_multiplier = 5.0",
+    "",
+])
+with open("pyproject.toml", "a") as fh:
+    fh.write(section)
+EOF
+
+export NUMBA_DISABLE_JIT=1
+export PYTHONHASHSEED=0
+# shellcheck disable=SC2086
+nice -n 10 "$MUTMUT" run --max-children "$JOBS" $MUTANTS || true
+
+"$MUTMUT" results --all true > mutmut-results.txt
+"$PY" - "$MUTMUT" $MUTANTS <<'EOF'
+"""Score the mutants matched by the globs; show the diff of every survivor."""
+import fnmatch
+import subprocess
+import sys
+from collections import Counter
+
+mutmut, patterns = sys.argv[1], sys.argv[2:]
+statuses = {}
+for line in open("mutmut-results.txt"):
+    name, _, status = line.strip().rpartition(": ")
+    if name and any(fnmatch.fnmatch(name, p) for p in patterns):
+        statuses[name] = status
+count = Counter(statuses.values())
+survivors = sorted(n for n, s in statuses.items() if s != "killed")
+for name in survivors:
+    print(f"--- {name}: {statuses[name]}")
+    print(subprocess.run([mutmut, "show", name], capture_output=True, text=True).stdout)
+total = len(statuses)
+# A mutant that makes the tests hang (e.g. an advancement that never reaches s = 1) is
+# detected too: timeouts count as killed.
+killed = count["killed"] + count["timeout"]
+other = total - killed - count["survived"]
+print(f"by status: {dict(count)}")
+print(f"mutation score: {killed} killed / {total} mutants = "
+      f"{100.0 * killed / max(total, 1):.1f} %  (survived {count['survived']}, "
+      f"timeouts among killed {count['timeout']}, other {other})")
+sys.exit(0 if total and killed == total else 1)
+EOF

@@ -38,7 +38,7 @@ import hashlib
 import json
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 
@@ -387,10 +387,6 @@ class Trainer:
             validation_success_rate=float(ok.mean()), chosen_from=unique[best][0], state=state)
 
 
-def config_dict(config: GAConfig) -> dict[str, Any]:
-    return asdict(config)
-
-
 __all__ = ["GAConfig", "HISTORY_COLUMNS", "TrainResult", "TrainState", "Trainer", "breed",
-           "config_dict", "generation_seeds", "initial_population", "new_state", "seed_genomes",
-           "validation_seeds", "N_RULES"]
+           "generation_seeds", "initial_population", "new_state", "seed_genomes", "term_blocks",
+           "validation_seeds"]

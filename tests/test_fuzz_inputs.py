@@ -531,8 +531,15 @@ def test_blank_import_name_is_a_usage_error(tmp_path):
 
 
 @pytest.mark.parametrize("command", ["plan-out-dir", "plan-out-under-file", "export-out-file",
-                                     "import-out-file"])
-def test_output_path_that_cannot_be_written_is_one_error_line(tmp_path, command):
+                                     "import-out-file", "bench-out-file"])
+def test_output_path_that_cannot_be_written_is_one_error_line(tmp_path, command, monkeypatch):
+    if command == "bench-out-file":  # refused before any planning starts
+        import xfuzzy_rrt.bench.runner as runner
+
+        def no_planning(*a, **k):
+            raise AssertionError("bench planned although --out cannot be written")
+
+        monkeypatch.setattr(runner, "run_benchmark", no_planning)
     scenario = FIXTURES / "scenarios" / "two-circles.toml"
     (tmp_path / "adir").mkdir()
     (tmp_path / "afile").write_text("keep me")
@@ -543,6 +550,8 @@ def test_output_path_that_cannot_be_written_is_one_error_line(tmp_path, command)
         "export-out-file": ["rules", "export", EXPERT, "--format", "fll", "--out",
                             tmp_path / "afile"],
         "import-out-file": ["rules", "import", _fll_dir(tmp_path), "--out", tmp_path / "afile"],
+        "bench-out-file": ["bench", scenario, "--planners", "rrt", "--runs", "1", "--out",
+                           tmp_path / "afile"],
     }[command]
     code, _, err = run_main(args)
     where = tmp_path / ("adir" if command == "plan-out-dir" else "afile")

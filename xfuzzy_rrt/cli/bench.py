@@ -65,6 +65,10 @@ def _run(scenarios: List[Path], planners: str, runs: int, seed: int, rulebook: O
     from xfuzzy_rrt.bench.runner import check_planners, run_benchmark, scenario_files
     from xfuzzy_rrt.cli.common import load_scenario_warn
 
+    from xfuzzy_rrt.errors import InputError
+
+    if out.exists() and not out.is_dir():  # fail before planning, not after
+        raise InputError(str(out), "exists and is not a directory (--out names a folder)")
     names = check_planners([p.strip() for p in planners.split(",") if p.strip()])
     loaded = [load_scenario_warn(p) for p in scenario_files(scenarios)]
     result = run_benchmark(loaded, names, runs=runs, seed=seed, rulebook=rulebook,

@@ -14,25 +14,17 @@ Run: ``.venv/bin/python -m pytest benchmarks/test_bench_ompl.py --benchmark-only
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from xfuzzy_rrt.bench.runner import shipped_scenarios
 from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
 from xfuzzy_rrt.geometry.path_check import certify_path
-from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.ompl_bridge import make_validity_callback, plan_ompl
 
 SEEDS = range(50)
-SHARED_SCENARIOS = Path(__file__).resolve().parents[2] / "shared" / "scenarios"
 
 
-@pytest.fixture(scope="module")
-def scenario():
-    ref = SHARED_SCENARIOS / "paper-reference.toml"
-    return load_scenario(ref if ref.exists() else shipped_scenarios()[-1])
 
 
 def python_validity(arrays, margin=CERT_MARGIN_M):

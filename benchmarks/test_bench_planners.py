@@ -11,25 +11,17 @@ Uses ``../shared/scenarios/paper-reference.toml`` when present, else the shipped
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from xfuzzy_rrt.bench.runner import shipped_scenarios
 from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
-from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
 from xfuzzy_rrt.planners.rrt import plan_rrt
 
 SEEDS = range(50)
-SHARED_SCENARIOS = Path(__file__).resolve().parents[2] / "shared" / "scenarios"
 
 
-@pytest.fixture(scope="module")
-def scenario():
-    ref = SHARED_SCENARIOS / "paper-reference.toml"
-    return load_scenario(ref if ref.exists() else shipped_scenarios()[-1])
 
 
 @pytest.fixture(scope="module")

@@ -14,28 +14,18 @@ from __future__ import annotations
 
 import os
 import time
-from pathlib import Path
 
 import numpy as np
-import pytest
 
 from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
-from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
 from xfuzzy_rrt.training.evaluate import Problem
 from xfuzzy_rrt.training.ga import GAConfig, generation_seeds, initial_population
 from xfuzzy_rrt.training.genome import encode
 from xfuzzy_rrt.training.workers import make_evaluator
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "scenarios"
 
 
-@pytest.fixture(scope="module")
-def scenario():
-    ref = SHARED / "paper-reference.toml"
-    if not ref.exists():
-        pytest.skip("needs ../shared/scenarios/paper-reference.toml")
-    return load_scenario(ref)
 
 
 def test_one_paper_scale_generation(benchmark, scenario):

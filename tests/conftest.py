@@ -44,3 +44,28 @@ def shared_scenarios() -> list[Path]:
     if not SHARED_SCENARIOS.is_dir():
         return []
     return sorted(SHARED_SCENARIOS.glob("*.toml"))
+
+
+THIN_BOX_TOML = """
+name = "thin-box"
+description = "a thin box lying across the sweep of a straight arm, between coarse motion samples"
+[arm]
+links = [0.18, 0.12]
+link_radius = 0.005
+joint_limits_deg = [[-180.0, 180.0], [-180.0, 180.0]]
+[start]
+q_deg = [-60.0, 0.0]
+[goal]
+q_deg = [60.0, 0.0]
+[[obstacles]]
+type = "box"
+min = [0.2, {ylo}]
+max = [0.28, {yhi}]
+"""
+
+
+def thin_box(tmp_path: Path, ylo: float = -0.002, yhi: float = 0.002) -> Path:
+    """Write the thin-box scenario (a grazing case for sampled motion checks); return its path."""
+    path = tmp_path / "thin-box.toml"
+    path.write_text(THIN_BOX_TOML.format(ylo=ylo, yhi=yhi))
+    return path

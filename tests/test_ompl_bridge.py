@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import FIXTURES, PROJECT, shared_scenarios
+from conftest import FIXTURES, PROJECT, shared_scenarios, thin_box
 from exact_geometry import Oracle
 from xfuzzy_rrt.cli.main import main
 from xfuzzy_rrt.errors import InputError
@@ -28,22 +28,6 @@ SCENARIOS = (sorted((FIXTURES / "scenarios").glob("*.toml"))
              + [p for p in shared_scenarios() if p.stem == "paper-reference"])
 TWO_CIRCLES = FIXTURES / "scenarios" / "two-circles.toml"
 PEERS = ("ompl:RRT", "ompl:RRTConnect", "ompl:RRTstar", "ompl:BITstar")
-
-THIN_BOX = """
-name = "thin-box"
-description = "a 4 mm box across the sweep of the straight arm, between coarse motion samples"
-[arm]
-links = [0.18, 0.12]
-link_radius = 0.005
-[start]
-q_deg = [-60.0, 0.0]
-[goal]
-q_deg = [60.0, 0.0]
-[[obstacles]]
-type = "box"
-min = [0.2, -0.002]
-max = [0.28, 0.002]
-"""
 
 
 @pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
@@ -72,8 +56,7 @@ def test_ompl_paths_run_start_to_goal_exactly_and_certification_agrees_with_the_
 def test_a_grazing_edge_that_ompl_samples_past_is_flagged_with_its_depth(tmp_path):
     # One straight motion start -> goal (goal bias 1, huge range), checked by OMPL at 5 % of
     # the extent (~25 deg): its samples at -36, -12, 12, 36 deg miss the box at 0 deg.
-    file = tmp_path / "thin-box.toml"
-    file.write_text(THIN_BOX)
+    file = thin_box(tmp_path)
     s = load_scenario(file)
     r = plan_ompl(s, "ompl:RRT", seed=0, step_deg=1000.0, goal_bias=1.0,
                   validity_resolution=0.05)

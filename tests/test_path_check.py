@@ -8,7 +8,7 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import FIXTURES, PROJECT
+from conftest import FIXTURES, PROJECT, thin_box
 from exact_geometry import Oracle
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.collision import clearance
@@ -24,29 +24,6 @@ from xfuzzy_rrt.planners.rrt import plan_rrt
 SCENARIOS = sorted((FIXTURES / "scenarios").glob("*.toml")) + sorted(
     (PROJECT / "xfuzzy_rrt" / "data" / "scenarios").glob("*.toml"))
 PAPERISH = FIXTURES / "scenarios" / "two-circles.toml"
-
-THIN_BOX_TOML = """
-name = "thin-box"
-description = "a thin box lying across the sweep of a straight arm"
-[arm]
-links = [0.18, 0.12]
-link_radius = 0.005
-joint_limits_deg = [[-180.0, 180.0], [-180.0, 180.0]]
-[start]
-q_deg = [-60.0, 0.0]
-[goal]
-q_deg = [60.0, 0.0]
-[[obstacles]]
-type = "box"
-min = [0.2, {ylo}]
-max = [0.28, {yhi}]
-"""
-
-
-def thin_box(tmp_path, ylo=-0.002, yhi=0.002):
-    path = tmp_path / "thin-box.toml"
-    path.write_text(THIN_BOX_TOML.format(ylo=ylo, yhi=yhi))
-    return path
 
 
 @pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)

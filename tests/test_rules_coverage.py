@@ -137,7 +137,7 @@ def test_coverage_cli_writes_csv_and_page_from_scenarios_and_traces(run_cli, tmp
     runs = [plan_scenario(scen, "fuzzy-rrt", rulebook=load_rulebook(EXPERT), seed=s,
                           max_iter=300).iterations for s in (0, 1)]
     assert cov.groupby("output")["mass_share"].sum().to_numpy() == pytest.approx(1.0)
-    assert f"3 runs" in proc.stdout and f"{sum(runs) + res.iterations} iterations" in proc.stdout
+    assert "3 runs" in proc.stdout and f"{sum(runs) + res.iterations} iterations" in proc.stdout
     assert (tmp_path / "cov.html").read_text().count("cov-fig-") >= len(OUTPUTS)
 
 

@@ -101,8 +101,8 @@ def train(
         result = run_training(job, on_start=progress.start, on_generation=progress.generation,
                               on_chunk=progress.chunk, on_phase=progress.phase)
     except KeyboardInterrupt:
-        progress.phase(f"interrupted; the last complete generation is checkpointed: "
-                       f"continue with the same command plus --resume")
+        progress.phase("interrupted; the last complete generation is checkpointed: "
+                       "continue with the same command plus --resume")
         raise
     h = result.state.history
     typer.echo(f"generations run: {len(h)}; final best fitness {h[-1]['best_fitness']:.1f}; "

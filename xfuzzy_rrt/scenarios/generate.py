@@ -28,8 +28,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, clearance_kernel
 from xfuzzy_rrt.geometry.scenario import Arm, Box, Circle, Scenario
 
 GRID_DEG = 2.0
@@ -68,28 +70,32 @@ def _draw(rng: np.random.Generator, name: str) -> Scenario:
                     obstacles=tuple(obstacles))
 
 
+@nb.njit(cache=True, nogil=True)
+def _free_grid(links, base, radius, obstacles, angles, margin):
+    free = np.empty((angles.size, angles.size), dtype=np.bool_)
+    q = np.empty(2)
+    for i in range(angles.size):
+        q[0] = angles[i]
+        for j in range(angles.size):
+            q[1] = angles[j]
+            free[i, j] = clearance_kernel(links, base, radius, obstacles, q) > margin
+    return free
+
+
 def c_space_grid(scenario: Scenario, step_deg: float = GRID_DEG) -> tuple[np.ndarray, np.ndarray]:
     """``(angles, free)``: grid angles and a boolean [n, n] map of free configurations."""
-    from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, clearance_kernel
-
     a = scenario.arrays()
     angles = np.arange(-180.0, 180.0 + 1e-9, step_deg)
-    free = np.empty((angles.size, angles.size), dtype=bool)
-    q = np.empty(2)
-    for i, q1 in enumerate(angles):
-        q[0] = q1
-        for j, q2 in enumerate(angles):
-            q[1] = q2
-            free[i, j] = clearance_kernel(a.links, a.base, a.link_radius, a.obstacles, q) > CERT_MARGIN_M
-    return angles, free
+    return angles, _free_grid(a.links, a.base, a.link_radius, a.obstacles, angles, CERT_MARGIN_M)
 
 
-def grid_optimal_deg(scenario: Scenario, step_deg: float = GRID_DEG) -> float:
+def grid_optimal_deg(scenario: Scenario, step_deg: float = GRID_DEG,
+                     grid: tuple[np.ndarray, np.ndarray] | None = None) -> float:
     """Shortest 8-connected path through free cells from start to goal (inf if none)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
-    angles, free = c_space_grid(scenario, step_deg)
+    angles, free = grid if grid is not None else c_space_grid(scenario, step_deg)
     n = angles.size
     idx = np.arange(n * n).reshape(n, n)
     rows, cols, w = [], [], []
@@ -140,7 +146,7 @@ def scenario_toml(s: Scenario, description: str) -> str:
 def generate_one(seed: int, k: int, prefix: str = "gen") -> GeneratedProblem:
     """Problem ``k`` of generator ``seed`` (draws until one passes every check)."""
     from xfuzzy_rrt.errors import ScenarioError
-    from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, config_free, segment_free
+    from xfuzzy_rrt.geometry.collision import config_free, segment_free
     from xfuzzy_rrt.geometry.scenario import scenario_from_dict
     from xfuzzy_rrt.planners.rrt import plan_rrt
 
@@ -164,9 +170,10 @@ def generate_one(seed: int, k: int, prefix: str = "gen") -> GeneratedProblem:
             continue  # free, but closer than the planners' margin
         if not plan_rrt(s, seed=0, max_iter=RRT_BUDGET).success:
             continue  # not shown solvable
-        _, free = c_space_grid(s)
+        grid = c_space_grid(s)
+        free = grid[1]
         straight = float(np.linalg.norm(a.goal_deg - a.start_deg))
-        optimal = grid_optimal_deg(s)
+        optimal = grid_optimal_deg(s, grid=grid)
         fraction = float(1.0 - free.mean())
         desc = (f"generated (xfuzzy-rrt scenarios generate, seed {seed}, problem {k}); "
                 f"grid-optimal {optimal:.1f} deg, straight {straight:.1f} deg, "

@@ -10,7 +10,7 @@ number, whatever the engine or the worker count (tested).
 from __future__ import annotations
 
 import os
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Callable, Sequence
 
 import numpy as np
@@ -102,8 +102,6 @@ class ProcessEvaluator(Evaluator):
         parts = _chunks(genes.shape[0], CHUNKS_PER_WORKER * self.workers)
         futures = {self._pool.submit(_evaluate_in_worker, genes[sl], self.bounds_mode, seeds,
                                      self.max_iter): sl for sl in parts}
-        from concurrent.futures import as_completed
-
         for k, fut in enumerate(as_completed(futures), start=1):
             out[futures[fut]] = fut.result()
             if progress:

@@ -44,17 +44,10 @@ from xfuzzy_rrt.fuzzy.manifest import (
     format_manifest,
     parse_manifest,
 )
+from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.fuzzy.system import FuzzySystem, InputPartition
 from xfuzzy_rrt.fuzzy.text_format import SUFFIX, format_fis, parse_fis
-from xfuzzy_rrt.fuzzy.variables import (
-    DEFAULT_TERMS,
-    INPUTS,
-    N_INPUTS,
-    N_OUTPUTS,
-    N_RULES,
-    N_TERMS,
-    OUTPUTS,
-)
+from xfuzzy_rrt.fuzzy.variables import N_INPUTS, N_OUTPUTS, N_RULES, N_TERMS
 
 #: Environment variable naming a folder of rulebooks that replaces the shipped one.
 RULEBOOKS_ENV = "XFUZZY_RRT_RULEBOOKS"
@@ -83,25 +76,34 @@ def fis_file_name(output: str) -> str:
 
 @dataclass(frozen=True)
 class Rulebook:
-    """Six single-output TSK systems (OUTPUTS order) with a name, bounds mode and provenance."""
+    """Six single-output TSK systems (the semantics' output order) with a name, semantics,
+    bounds mode (paper semantics only; ``None`` otherwise) and provenance.
+
+    ``semantics`` is a :class:`~.semantics.Semantics` (or its name): it fixes the input and
+    output names, ranges and units every tool reads.
+    """
 
     name: str
-    bounds_mode: str
+    bounds_mode: str | None
     systems: tuple[FuzzySystem, ...]
     provenance: Mapping[str, Any] = field(default_factory=dict)
     description: str = ""
+    semantics: "_sem.Semantics" = _sem.PAPER
 
     def __post_init__(self) -> None:
+        sem = self.semantics if isinstance(self.semantics, _sem.Semantics) else _sem.get(self.semantics)
+        object.__setattr__(self, "semantics", sem)
         object.__setattr__(self, "systems", tuple(self.systems))
-        outputs = tuple(s.output for s in self.systems)
-        if outputs != OUTPUTS:
-            raise ValueError(f"systems must be {OUTPUTS} in that order, got {outputs}")
         for s in self.systems:
             if not isinstance(s, FuzzySystem):
                 raise ValueError(f"systems must be FuzzySystem objects, got {type(s).__name__}")
+        outputs = tuple(s.output for s in self.systems)
+        if outputs != sem.outputs or any(s.semantics is not sem for s in self.systems):
+            raise ValueError(f"systems must be {sem.outputs} of the {sem.name} semantics in that "
+                             f"order, got {outputs}")
         manifest = Manifest(
             name=self.name, bounds_mode=self.bounds_mode,
-            provenance=self.provenance, description=self.description,
+            provenance=self.provenance, description=self.description, semantics=sem.name,
         )  # validates; also freezes provenance
         object.__setattr__(self, "provenance", manifest.provenance)
 
@@ -111,7 +113,7 @@ class Rulebook:
         from xfuzzy_rrt.fuzzy.manifest import thaw
 
         return (_rebuild, (self.name, self.bounds_mode, self.systems, thaw(self.provenance),
-                           self.description))
+                           self.description, self.semantics.name))
 
     # ------------------------------------------------------------------ views
 
@@ -120,14 +122,25 @@ class Rulebook:
         return Manifest(
             name=self.name, bounds_mode=self.bounds_mode,
             provenance=self.provenance, description=self.description,
+            semantics=self.semantics.name,
         )
 
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        """Input names, in rule-index order."""
+        return self.semantics.inputs
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        """Output names, in system order."""
+        return self.semantics.outputs
+
     def system(self, output: str) -> FuzzySystem:
-        """The FIS for *output* (one of OUTPUTS)."""
+        """The FIS for *output* (one of :attr:`outputs`)."""
         try:
-            return self.systems[OUTPUTS.index(output)]
+            return self.systems[self.outputs.index(output)]
         except ValueError:
-            raise KeyError(f"unknown output {output!r}; outputs are {OUTPUTS}") from None
+            raise KeyError(f"unknown output {output!r}; outputs are {self.outputs}") from None
 
     def texts(self, compact: bool = False) -> dict[str, str]:
         """Canonical text of every file, keyed by file name (manifest first, then OUTPUTS).
@@ -181,10 +194,11 @@ class Rulebook:
         consts,
         *,
         name: str,
-        bounds_mode: str,
+        bounds_mode: str | None,
         provenance: Mapping[str, Any] | None = None,
         description: str = "",
         term_names: Mapping[str, tuple[str, ...]] | None = None,
+        semantics: "_sem.Semantics | str" = _sem.PAPER,
     ) -> "Rulebook":
         """Build a rulebook from engine arrays (what the GA trainer evolves).
 
@@ -199,25 +213,26 @@ class Rulebook:
             raise ValueError(f"knots must have shape {(N_OUTPUTS, N_INPUTS, N_TERMS)}, got {knots.shape}")
         if consts.shape != (N_OUTPUTS, N_RULES):
             raise ValueError(f"consts must have shape {(N_OUTPUTS, N_RULES)}, got {consts.shape}")
-        names = dict(DEFAULT_TERMS)
+        sem = semantics if isinstance(semantics, _sem.Semantics) else _sem.get(semantics)
+        names = dict(sem.default_terms)
         if term_names:
             names.update({k: tuple(v) for k, v in term_names.items()})
         systems = []
-        for f, output in enumerate(OUTPUTS):
+        for f, output in enumerate(sem.outputs):
             inputs = tuple(
                 InputPartition(name=inp, terms=names[inp], peaks=tuple(knots[f, i].tolist()))
-                for i, inp in enumerate(INPUTS)
+                for i, inp in enumerate(sem.inputs)
             )
             systems.append(FuzzySystem(output=output, inputs=inputs, consts=tuple(consts[f].tolist())))
         return cls(
             name=name, bounds_mode=bounds_mode, systems=tuple(systems),
-            provenance=dict(provenance or {}), description=description,
+            provenance=dict(provenance or {}), description=description, semantics=sem,
         )
 
 
-def _rebuild(name, bounds_mode, systems, provenance, description) -> "Rulebook":
+def _rebuild(name, bounds_mode, systems, provenance, description, semantics="paper") -> "Rulebook":
     return Rulebook(name=name, bounds_mode=bounds_mode, systems=systems, provenance=provenance,
-                    description=description)
+                    description=description, semantics=semantics)
 
 
 # ------------------------------------------------------------------------- locations
@@ -239,7 +254,8 @@ def default_rulebook_path() -> Path:
 def _stamp(root: Path) -> tuple:
     """What identifies a rulebook directory's current contents cheaply (no reading)."""
     out = []
-    for name in [MANIFEST_NAME, *(fis_file_name(o) for o in OUTPUTS)]:
+    fis_names = sorted(p.name for p in root.glob("*" + SUFFIX)) if root.is_dir() else []
+    for name in [MANIFEST_NAME, *fis_names]:
         try:
             st = (root / name).stat()
             out.append((name, st.st_mtime_ns, st.st_size, st.st_ino))
@@ -302,41 +318,44 @@ def load_rulebook(path: str | os.PathLike[str]) -> Rulebook:
     if not root.is_dir():
         raise RulebookError([(str(root), None, "not a directory (a rulebook is a directory)")])
     problems: list[tuple[str, int | None, str]] = []
-    expected = [MANIFEST_NAME, *(fis_file_name(o) for o in OUTPUTS)]
+    all_outputs = {o for s in _sem.SEMANTICS.values() for o in s.outputs}
+    expected = [MANIFEST_NAME, *(fis_file_name(o) for o in sorted(all_outputs))]
     if not any((root / name).exists() for name in expected):
         # Not a damaged rulebook but no rulebook at all: one line, not seven "missing file"s.
         raise RulebookError([(str(root), None, f"not a rulebook directory (no {MANIFEST_NAME} "
                               f"and no {SUFFIX} files)")])
-    try:
-        extra = sorted(
-            p.name for p in root.iterdir()
-            if p.suffix == SUFFIX and p.stem not in OUTPUTS
-        )
-    except OSError as exc:
-        raise RulebookError([(str(root), None, f"cannot list directory: {exc.strerror or exc}")]) from None
-    for name in extra:
-        problems.append(
-            (str(root / name), None, f"unexpected FIS file (outputs are {', '.join(OUTPUTS)})")
-        )
     manifest = None
     data = _read(root / MANIFEST_NAME, problems)
     if data is not None:
         manifest, found = parse_manifest(data, str(root / MANIFEST_NAME))
         problems.extend(found)
+    sem = _sem.get(manifest.semantics) if manifest is not None else _sem.PAPER
+    try:
+        extra = sorted(
+            p.name for p in root.iterdir()
+            if p.suffix == SUFFIX and p.stem not in sem.outputs
+        )
+    except OSError as exc:
+        raise RulebookError([(str(root), None, f"cannot list directory: {exc.strerror or exc}")]) from None
+    for name in extra:
+        problems.append(
+            (str(root / name), None, f"unexpected FIS file (the {sem.name} semantics' outputs "
+                                     f"are {', '.join(sem.outputs)})")
+        )
     systems = []
-    for output in OUTPUTS:
+    for output in sem.outputs:
         file = root / fis_file_name(output)
         data = _read(file, problems)
         if data is None:
             continue
-        fis, found = parse_fis(data, str(file), output)
+        fis, found = parse_fis(data, str(file), output, sem)
         problems.extend(found)
         systems.append(fis)
     if problems:
         raise RulebookError(problems)
     return Rulebook(
         name=manifest.name, bounds_mode=manifest.bounds_mode, systems=tuple(systems),
-        provenance=manifest.provenance, description=manifest.description,
+        provenance=manifest.provenance, description=manifest.description, semantics=sem,
     )
 
 

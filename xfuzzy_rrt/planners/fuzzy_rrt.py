@@ -63,6 +63,24 @@ from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path, nearest
 MIN_STEP_DEG = 0.5
 BOUNDS_ABSOLUTE = 0
 BOUNDS_RELATIVE = 1
+#: Kernel mode of a goal-frame rulebook (see :mod:`xfuzzy_rrt.planners.goal_frame`).
+GOAL_FRAME = 2
+
+
+def kernel_mode(rb) -> int:
+    """The integer mode the compiled kernels take for rulebook *rb* (chosen once per plan)."""
+    if rb.semantics.name == "goal-frame":
+        return GOAL_FRAME
+    return BOUNDS_RELATIVE if rb.bounds_mode == "relative" else BOUNDS_ABSOLUTE
+
+
+def kernel_for(mode: int):
+    """The compiled loop for *mode*: the paper's Algorithm 1 or its goal-frame variant."""
+    if mode == GOAL_FRAME:
+        from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
+
+        return goal_frame_kernel
+    return fuzzy_rrt_kernel
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -226,12 +244,13 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     check_max_iter(max_iter)
     rb = _resolve_rulebook(rulebook)
     knots, consts = rb.compiled
-    mode = BOUNDS_RELATIVE if rb.bounds_mode == "relative" else BOUNDS_ABSOLUTE
+    mode = kernel_mode(rb)
+    kernel = kernel_for(mode)
     a = scenario.arrays()
     tree = Tree(int(max_iter) + 2, a.limits_deg)
     buffers = _TraceBuffers(int(max_iter) if trace else 1)
     t0 = time.perf_counter()
-    ok, iterations, last = fuzzy_rrt_kernel(
+    ok, iterations, last = kernel(
         a.links, a.base, a.link_radius, a.obstacles, a.limits_deg, a.start_deg, a.goal_deg,
         int(seed), int(max_iter), knots, consts, mode, float(min_step_deg), float(margin),
         tree.nodes, tree.parent, tree.cell_next, tree.cell_head, tree.meta, tree.grid,
@@ -245,7 +264,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
         rulebook=rb.name, rulebook_sha256=rb.sha256,
-        params={"max_iter": int(max_iter), "bounds": rb.bounds_mode,
+        params={"max_iter": int(max_iter), "semantics": rb.semantics.name, "bounds": rb.bounds_mode,
                 "min_step_deg": float(min_step_deg), "margin_m": float(margin)},
     )
     if trace:

@@ -16,6 +16,7 @@ numbers a training run writes.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import shlex
 from dataclasses import dataclass, field
@@ -27,6 +28,8 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.training.ga import HISTORY_COLUMNS, GAConfig, Trainer, TrainResult, new_state
 
 CHECKPOINT_DIR = "checkpoint"
+#: RRT runs per scenario (seeds 0..49) behind the log-ratio fitness's baseline.
+BASELINE_RUNS = 50
 HISTORY_FILE = "history.csv"
 
 
@@ -71,7 +74,8 @@ def load_training_scenarios(paths: list[Path]) -> list[TrainingScenario]:
     return items
 
 
-def canonical_command(config: GAConfig, scenario_args: list[str], out: str) -> str:
+def canonical_command(config: GAConfig, scenario_args: list[str], out: str,
+                      validation_args: list[str] = ()) -> str:
     """The command that reproduces this training run (independent of workers and engine).
 
     ``scenario_args`` are the ``--scenario`` values as given (a folder stays a folder; the
@@ -88,14 +92,27 @@ def canonical_command(config: GAConfig, scenario_args: list[str], out: str) -> s
                ("crossover_prob", "--crossover-prob"), ("crossover_eta", "--crossover-eta"),
                ("mutation_rate", "--mutation-rate"), ("mutation_eta", "--mutation-eta"),
                ("block_rate", "--block-rate"), ("block_sigma", "--block-sigma"),
-               ("init", "--init"), ("validation_runs", "--validation-runs")]
+               ("init", "--init"), ("validation_runs", "--validation-runs"),
+               ("fitness", "--fitness")]
     always = {"population", "generations", "runs_per_eval", "target_fitness", "seed", "bounds"}
     for attr, flag in options:
         value = getattr(config, attr)
         if attr in always or value != getattr(defaults, attr):
             args += [flag, f"{value:g}" if isinstance(value, float) else str(value)]
+    for a in validation_args:
+        args += ["--validation-scenario", a]
     args += ["--out", out]
     return " ".join(shlex.quote(a) for a in args)
+
+
+def baselines(scenarios: list[TrainingScenario], max_iter: int) -> tuple[float, ...]:
+    """RRT's median iterations on each scenario over seeds ``0..BASELINE_RUNS-1``."""
+    import numpy as np
+
+    from xfuzzy_rrt.training.evaluate import Problem, rrt_baseline
+
+    problems = [Problem.from_scenario(t.scenario) for t in scenarios]
+    return tuple(float(b) for b in rrt_baseline(problems, np.arange(BASELINE_RUNS), max_iter))
 
 
 def history_frame(history: list[dict]):
@@ -119,6 +136,8 @@ class TrainJob:
     scenarios: list[TrainingScenario]
     out: Path
     scenario_args: list[str] = field(default_factory=list)  # --scenario values as given
+    validation: list[TrainingScenario] = field(default_factory=list)  # held-out scenarios
+    validation_args: list[str] = field(default_factory=list)
     resume: bool = False
     workers: int | None = None
     scheduler: str | None = None
@@ -163,6 +182,7 @@ def run_training(job: TrainJob,
             expert = load_rulebook(expert_dir)
         state = new_state(config, expert)
     problems = [Problem.from_scenario(t.scenario) for t in job.scenarios]
+    held_out = [Problem.from_scenario(t.scenario) for t in job.validation]
     job.out.mkdir(parents=True, exist_ok=True)
     _remove_stale_temporaries(job)
     history_path = job.out / HISTORY_FILE
@@ -173,17 +193,26 @@ def run_training(job: TrainJob,
         if on_generation:
             on_generation(row)
 
-    with make_evaluator(problems, config.bounds, config.max_iter, job.workers,
-                        job.scheduler) as evaluator:
+    with contextlib.ExitStack() as stack:
+        evaluator = stack.enter_context(make_evaluator(problems, config.bounds, config.max_iter,
+                                                       job.workers, job.scheduler))
+        validator = None
+        if held_out:
+            validator = stack.enter_context(make_evaluator(held_out, config.bounds,
+                                                           config.max_iter, job.workers,
+                                                           job.scheduler))
         if on_start:
             on_start(evaluator.description, state.generation)
         if state.history:
             write_history(history_path, state.history)
-        trainer = Trainer(config, evaluator, on_generation=checkpoint, on_chunk=on_chunk)
+        trainer = Trainer(config, evaluator, on_generation=checkpoint, on_chunk=on_chunk,
+                          validator=validator)
         state = trainer.run(state)
         if on_phase:
-            on_phase(f"choosing the rulebook: {config.validation_runs} validation runs per "
-                     f"scenario for each generation's best")
+            where = (f"{len(held_out)} held-out validation scenarios" if held_out
+                     else "the training scenarios (fresh seeds)")
+            on_phase(f"choosing the rulebook: {config.validation_runs} runs per scenario on "
+                     f"{where} for each generation's best and the final top 5")
         result = trainer.choose(state)
     write_trained_rulebook(job, result)
     return result
@@ -204,13 +233,16 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
     from xfuzzy_rrt.training.genome import decode
 
     c = job.config
-    knots, consts = decode(result.genes)
+    from xfuzzy_rrt.training.genome import semantics_of_mode
+
+    knots, consts = decode(result.genes, c.bounds)
     history = result.state.history
     name = job.name or job.out.name or "trained"
+    sem = semantics_of_mode(c.bounds)
     provenance = {
         "kind": "ga",
         "command": canonical_command(c, job.scenario_args or [t.path for t in job.scenarios],
-                                     str(job.out)),
+                                     str(job.out), job.validation_args),
         "algorithm": "generational GA: tournament selection, SBX crossover, polynomial and "
                      "term-block mutation, elitism (xfuzzy_rrt.training)",
         "package_version": __version__,
@@ -230,14 +262,27 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
         "validation_median_iterations": result.validation_iterations_median,
         "validation_success_rate": result.validation_success_rate,
         "history": HISTORY_FILE,
+        "fitness": c.fitness,
         "scenarios": [{"name": t.scenario.name, "file": t.path, "sha256": t.sha256}
                       for t in job.scenarios],
         **job.extra_provenance,
     }
-    description = (f"Trained by the genetic algorithm ({c.bounds} bounds) on "
+    if c.fitness == "log-ratio":
+        provenance["baseline"] = ("RRT median iterations per training scenario (seeds 0.."
+                                  f"{BASELINE_RUNS - 1}, step 10 deg, goal bias 0.05)")
+        provenance["baseline_iterations"] = [float(b) for b in c.baseline]
+    if job.validation:
+        provenance["validation_fitness_history"] = [float(r["validation_fitness"]) for r in history]
+        provenance["validation_scenarios"] = [
+            {"name": t.scenario.name, "file": t.path, "sha256": t.sha256} for t in job.validation]
+        if c.fitness == "log-ratio":
+            provenance["validation_baseline_iterations"] = [float(b) for b in c.validation_baseline]
+    what = "goal-frame semantics" if sem.name == "goal-frame" else f"{c.bounds} bounds"
+    description = (f"Trained by the genetic algorithm ({what}, {c.fitness} fitness) on "
                    f"{len(job.scenarios)} scenario(s); see [provenance].")
-    rb = Rulebook.from_arrays(knots[0], consts[0], name=name, bounds_mode=c.bounds,
-                              provenance=provenance, description=description)
+    rb = Rulebook.from_arrays(knots[0], consts[0], name=name,
+                              bounds_mode=None if sem.name == "goal-frame" else c.bounds,
+                              provenance=provenance, description=description, semantics=sem)
     return save_rulebook(rb, job.out)
 
 

@@ -28,7 +28,7 @@ _PROBLEMS: list[Problem] | None = None  # set once per worker process by _init_w
 def evaluate_chunk(genes: np.ndarray, problems: Sequence[Problem], bounds_mode: str,
                    seeds: np.ndarray, max_iter: int) -> np.ndarray:
     """Iterations int64[n, S, R] of the individuals ``genes`` [n, 3822]."""
-    knots, consts = decode(genes)
+    knots, consts = decode(genes, bounds_mode)
     return iterations_for(list(problems), knots, consts, bounds_mode, seeds, max_iter)
 
 

@@ -42,7 +42,7 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.cover import Partition, min_partition
 from xfuzzy_rrt.fuzzy.manifest import thaw
 from xfuzzy_rrt.fuzzy.system import FuzzySystem
-from xfuzzy_rrt.fuzzy.variables import N_OUTPUTS, N_RULES, OUTPUT_RANGES
+from xfuzzy_rrt.fuzzy.variables import N_OUTPUTS, N_RULES
 
 LEVEL_LADDER = (2, 3, 4, 5, 6, 8, 12, 16, 24, 32)
 TOLERANCE_LADDER = (0.5, 0.4, 0.3, 0.25, 0.2, 0.15, 0.1, 0.05, 0.02, 0.01)
@@ -140,7 +140,7 @@ def build_candidate(rulebook, levels: int | None = None, tolerance: float = 0.0,
     parts = []
     consts = np.empty((N_OUTPUTS, N_RULES))
     for f, s in enumerate(rulebook.systems):
-        lo, hi = OUTPUT_RANGES[s.output]
+        lo, hi = s.range
         v = np.asarray(s.consts, dtype=np.float64)
         if levels is not None:
             v = quantise(v, levels, lo, hi)

@@ -43,7 +43,7 @@ def eval_(
     from xfuzzy_rrt.fuzzy.tables import evaluate_frame, read_inputs_csv
 
     rb = load_rulebook(rulebook)
-    df = read_inputs_csv(input)
+    df = read_inputs_csv(input, rb.inputs)
     result = evaluate_frame(rb, df)
     with atomic_path(output) as tmp:
         result.to_csv(tmp, index=False, float_format="%.17g")
@@ -79,7 +79,7 @@ def show(
     from xfuzzy_rrt.fuzzy.manifest import thaw
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
     from xfuzzy_rrt.fuzzy.summary import consequent_stats, matching_rules, parse_conditions
-    from xfuzzy_rrt.fuzzy.variables import INPUTS, N_RULES, OUTPUTS
+    from xfuzzy_rrt.fuzzy.variables import N_RULES
 
     rb = load_rulebook(rulebook)
     if rules:
@@ -97,10 +97,10 @@ def show(
         where = parse_conditions(when, rb)
         rows = matching_rules(rb, where)
         inputs = rb.systems[0].inputs
-        header = ["rule", *INPUTS, *OUTPUTS]
+        header = ["rule", *rb.inputs, *rb.outputs]
         table = [header]
         for r, t, values in rows:
-            table.append([f"r{r}", *(inputs[i].terms[t[i]] for i in range(len(INPUTS))),
+            table.append([f"r{r}", *(inputs[i].terms[t[i]] for i in range(len(rb.inputs))),
                           *(_num(v) for v in values)])
         widths = [max(len(row[j]) for row in table) for j in range(len(header))]
         lines = ["  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip() for row in table]
@@ -407,7 +407,6 @@ def simplify_cmd(
     from xfuzzy_rrt.cli.common import load_scenario_warn
     from xfuzzy_rrt.errors import InputError
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, save_rulebook
-    from xfuzzy_rrt.fuzzy.variables import OUTPUTS
 
     rb = load_rulebook(rulebook)
     if out.exists() and out.resolve() == rulebook.resolve():
@@ -440,7 +439,7 @@ def simplify_cmd(
     before = int(res.measures_before["rules"].iloc[-1])
     lines.append(f"result: {kind}; rules {before} -> {res.lossless_rules} lossless -> "
                  f"{res.chosen.rules} written")
-    not_proven = [o for o, p in zip(OUTPUTS, res.chosen.partitions) if not p.optimal]
+    not_proven = [s.output for s, p in zip(rb.systems, res.chosen.partitions) if not p.optimal]
     lines.append("rule count: proven minimal for every FIS (exact 0/1 programme)" if not not_proven
                  else f"rule count: not proven minimal for {', '.join(not_proven)} (solver time limit)")
     if res.budget is not None:

@@ -158,3 +158,12 @@ def _check() -> None:
 
 
 _check()
+
+
+def of_columns(columns) -> Semantics:
+    """The semantics whose inputs name columns of a trace or table (the paper's by default)."""
+    cols = set(columns)
+    for s in SEMANTICS.values():
+        if s.inputs[0] in cols:
+            return s
+    return DEFAULT

@@ -56,7 +56,8 @@ def lint(rulebook: Path = typer.Argument(..., help="Rulebook directory.")) -> in
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 
     rb = load_rulebook(rulebook)
-    _out(f"ok: {rulebook}: rulebook {rb.name!r} ({rb.bounds_mode} bounds), sha256 {rb.sha256}")
+    kind = f"{rb.bounds_mode} bounds" if rb.bounds_mode else f"{rb.semantics.name} semantics"
+    _out(f"ok: {rulebook}: rulebook {rb.name!r} ({kind}), sha256 {rb.sha256}")
     return 0
 
 
@@ -108,7 +109,8 @@ def show(
         _out("\n".join(lines))
         return 0
 
-    lines = [f"rulebook {rb.name!r}  ({rulebook})", f"  bounds mode: {rb.bounds_mode}",
+    lines = [f"rulebook {rb.name!r}  ({rulebook})", f"  semantics: {rb.semantics.summary}",
+             f"  bounds mode: {rb.bounds_mode or '(none: not the paper semantics)'}",
              f"  sha256: {rb.sha256}"]
     if rb.description:
         lines.append(f"  description: {rb.description}")

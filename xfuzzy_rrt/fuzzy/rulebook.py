@@ -88,10 +88,16 @@ class Rulebook:
     systems: tuple[FuzzySystem, ...]
     provenance: Mapping[str, Any] = field(default_factory=dict)
     description: str = ""
-    semantics: "_sem.Semantics" = _sem.PAPER
+    semantics: "_sem.Semantics | str | None" = None  # None: the systems' own semantics
 
     def __post_init__(self) -> None:
-        sem = self.semantics if isinstance(self.semantics, _sem.Semantics) else _sem.get(self.semantics)
+        if self.semantics is None:
+            first = self.systems[0] if len(self.systems) else None
+            sem = first.semantics if isinstance(first, FuzzySystem) else _sem.PAPER
+        elif isinstance(self.semantics, _sem.Semantics):
+            sem = self.semantics
+        else:
+            sem = _sem.get(self.semantics)
         object.__setattr__(self, "semantics", sem)
         object.__setattr__(self, "systems", tuple(self.systems))
         for s in self.systems:

@@ -333,3 +333,41 @@ def test_every_damaged_checkpoint_byte_is_caught_or_harmless(tmp_path):
         else:  # the damage hit bytes nothing reads (e.g. zip comments): same state
             assert np.array_equal(loaded.population, state.population)
             assert loaded.rng_state == state.rng_state
+
+
+def test_a_checkpoint_with_an_unknown_array_or_meta_key_is_refused(tmp_path):
+    import io
+    import json
+
+    from xfuzzy_rrt.errors import InputError
+    from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
+    from xfuzzy_rrt.training.ga import new_state
+
+    config = GAConfig(population=4, elite=1, scenarios=(("a", "b"),))
+    path = save_checkpoint(tmp_path, new_state(config), config)
+
+    def rewrite(change) -> None:
+        with np.load(io.BytesIO(path.read_bytes()), allow_pickle=False) as z:
+            arrays = {name: z[name] for name in z.files}
+        change(arrays)
+        with open(path, "wb") as fh:
+            np.savez(fh, **arrays)
+
+    good = path.read_bytes()
+    rewrite(lambda a: a.update(populaton=a["population"]))
+    with pytest.raises(InputError, match=r"unknown key 'populaton' in the arrays \(did you mean "
+                                         r"'population'\?\)"):
+        load_checkpoint(tmp_path, config)
+
+    path.write_bytes(good)
+
+    def add_meta_key(a):
+        meta = json.loads(str(a["meta"][()]))
+        meta["generations"] = 3
+        a["meta"] = np.array(json.dumps(meta))
+
+    rewrite(add_meta_key)
+    with pytest.raises(InputError) as info:
+        load_checkpoint(tmp_path, config)
+    assert str(info.value) == (f"{path}: unknown key 'generations' in meta "
+                               f"(did you mean 'generation'?)")

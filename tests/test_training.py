@@ -294,6 +294,31 @@ def test_default_rulebook_is_parsed_once_while_unchanged(tmp_path, monkeypatch):
     assert len(calls) == 2  # an edited file is re-read
 
 
+def test_a_same_size_edit_with_the_old_mtime_is_not_served_from_the_cache(tmp_path):
+    # cp -p, rsync -t and tar x restore timestamps: only the bytes tell the edit apart
+    import re
+
+    import xfuzzy_rrt.fuzzy.rulebook as rbmod
+
+    root = tmp_path / "rb"
+    shutil.copytree(rbmod.default_rulebook_path(), root)
+    fis = root / "step_size.fis"
+    before = rbmod.load_rulebook_cached(root)
+    st_before = fis.stat()
+    text = fis.read_text()
+    old = re.search(r"r0: .* then step_size = (\S+)", text).group(1)
+    new = old[:-1] + ("1" if old[-1] != "1" else "2")  # same length, another value
+    edited = text.replace(f"then step_size = {old}\n", f"then step_size = {new}\n", 1)
+    assert edited != text and len(edited) == len(text)
+    fis.write_text(edited)
+    os.utime(fis, ns=(st_before.st_atime_ns, st_before.st_mtime_ns))
+    assert fis.stat().st_size == st_before.st_size
+    assert fis.stat().st_mtime_ns == st_before.st_mtime_ns
+    after = rbmod.load_rulebook_cached(root)
+    assert after is not before
+    assert after.sha256 == rbmod.load_rulebook(root).sha256 != before.sha256
+
+
 def test_resuming_a_finished_run_with_more_generations_equals_the_longer_run(tmp_path):
     (tmp_path / "long").mkdir()
     assert _train(tmp_path / "long", "--workers", "1", "--generations", "4").returncode == 0

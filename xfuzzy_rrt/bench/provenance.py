@@ -40,8 +40,26 @@ def _git(*args: str) -> str | None:
     return out.stdout.strip() if out.returncode == 0 else None
 
 
+def _running_from_checkout() -> bool:
+    """Whether this package is the source folder of a git checkout (an editable install).
+
+    An installed wheel sits in ``site-packages``, which may itself lie inside some unrelated
+    repository (a virtualenv in a project folder): its commit says nothing about this code.
+    """
+    root = Path(__file__).resolve().parents[2]
+    if not (root / "pyproject.toml").is_file():
+        return False
+    top = _git("rev-parse", "--show-toplevel")
+    return top is not None and Path(top).resolve() == root
+
+
 def git_state() -> dict[str, Any]:
-    """Commit of the checkout the package runs from, and whether tracked files differ from it."""
+    """Commit of the checkout the package runs from, and whether tracked files differ from it.
+
+    ``None`` for both when the package is not running from a checkout (an installed wheel).
+    """
+    if not _running_from_checkout():
+        return {"commit": None, "dirty": None}
     commit = _git("rev-parse", "HEAD")
     if not commit:
         return {"commit": None, "dirty": None}

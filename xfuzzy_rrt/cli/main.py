@@ -58,40 +58,26 @@ _PLANNING = {"plan", "bench", "demo", "explain", "train", ("rules", "coverage"),
              ("rules", "diff"), ("rules", "simplify"), ("scenarios", "generate")}
 
 
-#: Seconds a command with a cold compile cache runs before the notice: a bad argument fails
-#: sooner, so its one error line stays the only line.
-_COMPILE_NOTICE_AFTER_S = 1.0
-
-
-def _announce_first_compile(args: list[str]):
-    """Schedule one stderr line for when numba has to compile the kernels (the first run after
-    an install takes tens of seconds: say why rather than look hung). Returns the timer, to be
-    cancelled when the command ends, or ``None`` when nothing needs compiling."""
+def _announce_first_compile(args: list[str]) -> None:
+    """One stderr line when numba starts compiling (the first run after an install takes tens
+    of seconds: say why rather than look hung). Nothing when the kernels come from its cache."""
     words = [a for a in args if not a.startswith("-")][:2]
     if not words or "--help" in args or not (words[0] in _PLANNING or tuple(words) in _PLANNING):
-        return None
-    import threading
-
-    from xfuzzy_rrt.compile_cache import cold_kernels
-
-    if not cold_kernels():
-        return None
+        return
+    from xfuzzy_rrt.compile_notice import notify_first_compile
 
     def say() -> None:
         sys.stderr.write("compiling planners, first run only…\n")
         sys.stderr.flush()
 
-    timer = threading.Timer(_COMPILE_NOTICE_AFTER_S, say)
-    timer.daemon = True
-    timer.start()
-    return timer
+    notify_first_compile(say)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; return (and, as a script, exit with) the process exit code."""
     args = sys.argv[1:] if argv is None else list(argv)
     command = typer.main.get_command(app)
-    notice = _announce_first_compile(args)
+    _announce_first_compile(args)
     try:
         rv = command.main(args=args, prog_name="xfuzzy-rrt", standalone_mode=False)
     except RulebookError as exc:
@@ -124,9 +110,6 @@ def main(argv: list[str] | None = None) -> int:
         code = 130
     else:
         code = rv if isinstance(rv, int) else 0
-    finally:
-        if notice is not None:
-            notice.cancel()
     if argv is None:
         if "ompl" in sys.modules:
             # OMPL 2.0.1's bindings (nanobind) keep some planner objects alive on purpose and

@@ -76,6 +76,13 @@ def test_unknown_table_fails_plan_with_one_line_exit_2(run_cli, tmp_path):
     assert not out.exists()
 
 
+def test_an_explicit_empty_obstacle_list_is_accepted(tmp_path):
+    text = (FIXTURES / "scenarios" / "empty.toml").read_text()
+    p = tmp_path / "explicit.toml"
+    p.write_text("obstacles = []\n" + text)
+    assert load_scenario(p).obstacles == ()
+
+
 def test_safety_clearance_is_validated_and_defaults_to_zero(tmp_path):
     assert load_scenario(FIXTURES / "scenarios" / "two-circles.toml").clearance_m == 0.0
     ok = _with(tmp_path, "[start]", "[safety]\nclearance_m = 0.003\n[start]")

@@ -21,9 +21,9 @@ PAPER_REFERENCE = ("data", "reference", "paper-reference.toml")
 
 
 def _as_path(traversable) -> Path:
-    """A real directory path (the project never runs from a zip file)."""
-    path = Path(str(traversable))
-    return path
+    """A real file-system path: the package is always installed unpacked (wheel or editable),
+    never imported from a zip file."""
+    return Path(str(traversable))
 
 
 def shipped_rulebooks_dir() -> Path:

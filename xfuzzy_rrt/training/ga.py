@@ -117,6 +117,10 @@ class GAConfig:
         """SHA-256 of the options that shape the search (identifies a checkpoint's run),
         including the training scenarios' and the seed rulebooks' SHA-256."""
         fields = {k: v for k, v in asdict(self).items() if k not in self.STOPPING}
+        if not fields["seed_rulebooks"]:
+            # absent rather than empty: a run without seed rulebooks keeps the fingerprint it
+            # had before they were recorded, so its checkpoints still resume
+            del fields["seed_rulebooks"]
         blob = json.dumps(fields, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()
 

@@ -257,3 +257,21 @@ def test_protocol_rejects_an_unknown_rulebook_with_one_line(run_cli):
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
         "error: --rulebook: 'no-such-rulebook' is neither a shipped rulebook nor a directory"]
+
+
+def test_rule_analysis_tools_work_on_goal_frame_rulebooks(tmp_path, run_cli):
+    save_rulebook(_rulebook(jitter=0.05, seed=8), tmp_path / "gf")
+    proc = run_cli("rules", "coverage", tmp_path / "gf", SCENARIOS[0], "--runs", "3",
+                   "--out", tmp_path / "cov.csv")
+    assert proc.returncode == 0, proc.stderr
+    cov = pd.read_csv(tmp_path / "cov.csv")
+    assert set(cov["output"]) == set(GF.outputs) and len(cov) == 6 * 625
+    proc = run_cli("rules", "simplify", tmp_path / "gf", "--out", tmp_path / "simple")
+    assert proc.returncode == 0, proc.stderr
+    assert load_rulebook(tmp_path / "simple").semantics is GF
+    proc = run_cli("rules", "diff", tmp_path / "gf", tmp_path / "simple")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    proc = run_cli("rules", "show", tmp_path / "gf", "--when", "stagnation=stuck,reject_rate=blocked")
+    assert proc.returncode == 0 and "uniform_share" in proc.stdout
+    proc = run_cli("rules", "show", tmp_path / "gf", "--when", "dist_to_goal=near")
+    assert proc.returncode == 2 and "unknown input 'dist_to_goal'" in proc.stderr

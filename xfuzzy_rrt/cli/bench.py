@@ -117,17 +117,20 @@ def demo(
     """Benchmark RRT vs the trained Fuzzy-RRT and write the reports.
 
     Two benchmarks, everything shipped in the package: (1) RRT vs Fuzzy-RRT with the default
-    rulebook (``general``, trained on generated problems only) on PROBLEMS fresh problems of
-    the ``sample-*`` family that no training run saw (generator seed 2000; the files are written
-    to OUT/scenarios), into OUT; (2) RRT vs Fuzzy-RRT with the ``paper`` rulebook on the
-    paper's reference problem (the paper's setting), into OUT/paper-reference.
+    rulebook (``goal-frame``, trained on generated problems only) on the shipped demo scenarios
+    and PROBLEMS fresh problems of the ``sample-*`` family that no training run saw (generator
+    seed 2000; the files are written to OUT/scenarios), into OUT; (2) RRT vs Fuzzy-RRT with the
+    ``paper`` rulebook on the paper's reference problem (the paper's setting), into
+    OUT/paper-reference.
     """
     from xfuzzy_rrt.atomic import write_text_atomic
     from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
     from xfuzzy_rrt.resources import paper_reference_scenario
     from xfuzzy_rrt.scenarios.generate import generate_one
 
-    files = []
+    from xfuzzy_rrt.bench.runner import shipped_scenarios
+
+    files = list(shipped_scenarios())
     for k in range(problems):
         problem = generate_one(2000, k)
         path = out / "scenarios" / f"{problem.scenario.name}.toml"

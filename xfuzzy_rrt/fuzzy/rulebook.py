@@ -51,9 +51,9 @@ from xfuzzy_rrt.fuzzy.variables import N_INPUTS, N_OUTPUTS, N_RULES, N_TERMS
 
 #: Environment variable naming a folder of rulebooks that replaces the shipped one.
 RULEBOOKS_ENV = "XFUZZY_RRT_RULEBOOKS"
-#: The default of plan, bench and demo: the shipped rulebook that is best on problems it has never
-#: seen (measured against ``expert`` on generated problems; see rulebooks/README.md).
-DEFAULT_RULEBOOK = "general"
+#: The default of plan, bench and demo: the shipped rulebook that wins the fair protocol
+#: (``xfuzzy-rrt evaluate``) on problems no training or tuning saw (see rulebooks/README.md).
+DEFAULT_RULEBOOK = "goal-frame"
 
 __all__ = [
     "FuzzySystem",

@@ -114,7 +114,7 @@ def test_the_installed_wheel_plans_benchmarks_demos_and_trains_from_anywhere(ins
     # a fresh install compiles once, and says so on one line
     assert plan.stderr.splitlines().count("compiling planners, first run only…") == 1, plan.stderr
     result = json.loads((work / "p.json").read_text())
-    assert result["rulebook"] == "general"
+    assert result["rulebook"] == "goal-frame"
 
     again = run("plan", "problem.toml", "--planner", "fuzzy-rrt", "--seed", "2")
     assert again.returncode in (0, 1), again.stderr

@@ -76,10 +76,13 @@ def test_absolute_bounds_are_ordered_and_clipped_to_the_joint_limits():
     assert inside["sample_q2_deg"].between(-20 - 1e-9, 160).all()
 
 
-def test_relative_bounds_are_offsets_from_the_current_node(expert):
+def test_relative_bounds_are_offsets_from_the_current_node():
+    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+
+    relative = load_rulebook(rulebooks_dir() / "general")
     s = load_scenario(TWO_CIRCLES)
-    t = plan_fuzzy_rrt(s, expert, seed=5, trace=True).trace
-    assert expert.bounds_mode == "relative"
+    t = plan_fuzzy_rrt(s, relative, seed=5, trace=True).trace
+    assert relative.bounds_mode == "relative"
     lo1 = np.clip(t["from_q1_deg"] + np.minimum(t["bound_1"], t["bound_2"]), -180, 180)
     hi1 = np.clip(t["from_q1_deg"] + np.maximum(t["bound_1"], t["bound_2"]), -180, 180)
     np.testing.assert_array_equal(t["box_q1_lo"], lo1)

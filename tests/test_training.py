@@ -414,7 +414,7 @@ def test_generated_scenarios_are_valid_solvable_nontrivial_and_deterministic(tmp
 def test_default_rulebook_is_parsed_once_while_unchanged(tmp_path, monkeypatch):
     import xfuzzy_rrt.fuzzy.rulebook as rbmod
 
-    shutil.copytree(rbmod.default_rulebook_path(), tmp_path / "rb")
+    shutil.copytree(rbmod.rulebooks_dir() / "general", tmp_path / "rb")  # edits step_size.fis
     calls = []
     real = rbmod.load_rulebook
     monkeypatch.setattr(rbmod, "load_rulebook", lambda p: calls.append(p) or real(p))
@@ -441,7 +441,7 @@ def test_a_same_size_edit_with_the_old_mtime_is_not_served_from_the_cache(tmp_pa
     import xfuzzy_rrt.fuzzy.rulebook as rbmod
 
     root = tmp_path / "rb"
-    shutil.copytree(rbmod.default_rulebook_path(), root)
+    shutil.copytree(rbmod.rulebooks_dir() / "general", root)  # edits step_size.fis
     fis = root / "step_size.fis"
     before = rbmod.load_rulebook_cached(root)
     st_before = fis.stat()

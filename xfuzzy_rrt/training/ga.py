@@ -385,8 +385,9 @@ class Trainer:
             "success_rate": float(ok.mean()),
             "runs": runs,
             "runs_per_s": runs / wall if wall > 0 else float("nan"),
-            "validation_fitness": held_out,
         }
+        if self.validator is not None:
+            row["validation_fitness"] = held_out
         generation = state.generation + 1
         done = generation >= c.generations or fit[best] >= c.target_fitness
         rng = np.random.Generator(np.random.PCG64())

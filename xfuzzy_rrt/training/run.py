@@ -191,9 +191,13 @@ def baselines(scenarios: list[TrainingScenario], max_iter: int) -> tuple[float, 
 
 
 def history_frame(history: list[dict]):
+    """One row per generation; ``validation_fitness`` only when the run has held-out scenarios
+    (a run without them writes exactly the columns it always did)."""
     import pandas as pd
 
-    return pd.DataFrame(history, columns=HISTORY_COLUMNS)
+    held_out = any("validation_fitness" in row for row in history)
+    return pd.DataFrame(history, columns=[c for c in HISTORY_COLUMNS
+                                          if c != "validation_fitness" or held_out])
 
 
 def write_history(path: Path, history: list[dict]) -> None:

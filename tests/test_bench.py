@@ -78,7 +78,9 @@ def test_our_planners_paths_are_all_certified_and_shortcuts_never_longer(bench_d
     assert (ok["cost_short_deg"] <= ok["cost_deg"] + 1e-9).all()
     assert ok["cost_short_deg"].lt(ok["cost_deg"] - 1e-6).any(), "shortcutting never shortened"
     failed = result.runs[~result.runs["success"]]
-    assert failed["certified"].isna().all() and failed["cost_short_deg"].isna().all()
+    assert not failed["found"].any() and not failed["certified"].any()
+    assert failed["cost_short_deg"].isna().all() and failed["min_clearance_m"].isna().all()
+    assert (ok["found"] & ok["certified"]).all() and (ok["min_clearance_m"] > 0.0).all()
     assert (ok["time_first_s"] == ok["wall_s"]).all()
     assert (result.summary["certified_fraction"].dropna() == 1.0).all()
 

@@ -33,8 +33,17 @@ def test_rrt_paths_are_certified_with_zero_penetration_and_the_oracle_agrees(pat
     for seed in range(5):
         r = plan_rrt(s, seed=seed)
         check = certify_path(s.arrays(), r.path_deg)
-        assert check == PathCheck(certified=True, penetration_m=0.0, worst_segment=-1)
+        assert (check.certified, check.penetration_m, check.worst_segment) == (True, 0.0, -1)
         assert oracle.path_problems(r.path_deg) == []
+        if not oracle.circles and not oracle.boxes:
+            assert check.min_clearance_m == np.inf
+            continue
+        # The exact minimum: attained where it says, and nothing on the path comes closer.
+        assert oracle.clearance(np.array(check.min_config_deg))[0] == pytest.approx(
+            check.min_clearance_m, abs=1e-12)
+        assert float(np.min(oracle.clearance(oracle.densify(r.path_deg, 0.02)))) >= \
+            check.min_clearance_m - 1e-9
+        assert r.min_clearance_m == check.min_clearance_m
 
 
 def test_a_straight_path_through_obstacles_is_flagged_with_its_depth():
@@ -88,15 +97,19 @@ def test_deep_penetration_does_not_saturate_at_the_link_radius(tmp_path):
 def test_a_vertex_outside_the_joint_limits_is_not_certified_even_without_penetration():
     s = load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml")  # joint 1 up to 175
     inside = np.array([[160.0, 90.0], [170.0, 90.0]])
-    assert certify_path(s.arrays(), inside) == PathCheck(True, 0.0, -1)
+    check = certify_path(s.arrays(), inside)
+    assert (check.certified, check.penetration_m, check.worst_segment) == (True, 0.0, -1)
     path = np.array([[160.0, 90.0], [170.0, 90.0], [178.0, 90.0]])
     check = certify_path(s.arrays(), path)
     assert not check.certified and check.penetration_m == 0.0 and check.worst_segment == 1
+    assert check.limits_vertex == 2 and check.describe() == "vertex 2 is outside the joint limits"
 
 
 def test_an_empty_path_is_not_certified_and_a_malformed_one_is_rejected():
     a = load_scenario(PAPERISH).arrays()
-    assert certify_path(a, np.zeros((0, 2))) == PathCheck(False, 0.0, -1)
+    empty = certify_path(a, np.zeros((0, 2)))
+    assert (empty.certified, empty.penetration_m, empty.worst_segment) == (False, 0.0, -1)
+    assert np.isnan(empty.min_clearance_m) and empty.describe() == "no path to certify"
     with pytest.raises(InputError):
         certify_path(a, np.zeros((3, 3)))
     with pytest.raises(InputError):

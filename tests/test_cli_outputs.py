@@ -132,3 +132,13 @@ def test_bench_refuses_a_scenario_inside_the_folder_it_would_replace(run_cli, tm
     assert proc.stderr == (f"error: {inside.resolve()}: lies inside --out {out}, which the "
                            "bench replaces; move it or choose another --out\n")
     assert inside.is_file()
+
+
+def test_an_unwritable_atomic_output_names_the_file_not_its_hidden_temporary():
+    from xfuzzy_rrt.atomic import atomic_path
+
+    target = _unwritable_dir().parent / "xfuzzy-rrt-report.html"  # the folder itself exists
+    with pytest.raises(OSError) as info:
+        with atomic_path(target):
+            pass
+    assert info.value.filename == str(target)

@@ -64,6 +64,9 @@ class BenchResult:
     provenance: dict[str, Any] = field(default_factory=dict)
     #: Planner label (``fuzzy-rrt``, ``fuzzy-rrt:paper``, ...) -> the loaded rulebook it ran.
     rulebooks: dict[str, Any] = field(default_factory=dict)
+    #: For each (scenario, planner), the returned path that came closest to an obstacle (or went
+    #: deepest into one): what a safety audit looks at, next to the median run.
+    worst_examples: dict[tuple[str, str], PlanResult] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -194,6 +197,15 @@ def _median_run_seed(group: pd.DataFrame) -> int | None:
     return int(ok["seed"].iloc[int(np.argmin(np.abs(ok["iterations"].to_numpy() - target)))])
 
 
+def _worst_run_seed(group: pd.DataFrame) -> int | None:
+    """Seed of the found run with the smallest minimum clearance (the first on ties)."""
+    found = group[group["found"].astype(bool)]
+    if found.empty:
+        return None
+    clearance = pd.to_numeric(found["min_clearance_m"], errors="coerce").fillna(np.inf)
+    return int(found["seed"].iloc[int(np.argmin(clearance.to_numpy()))])
+
+
 def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50, seed: int = 0,
                   rulebook=None, max_iter: int = 10_000, workers: int = 1,
                   shortcut: bool = False, progress: Progress | None = None) -> BenchResult:
@@ -244,6 +256,13 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
             example = plan_scenario(by_name[scen], planner=planner, rulebook=rulebooks[planner],
                                     seed=seed_, max_iter=max_iter, trace=True)
         examples[(scen, planner)] = example
+    worst = {}
+    for (scen, planner), group in runs_df.groupby(["scenario", "planner"], sort=False):
+        seed_ = _worst_run_seed(group)
+        if seed_ is not None:
+            same = examples.get((scen, planner))
+            worst[(scen, planner)] = (same if same is not None and same.seed == seed_
+                                      else by_run[(scen, planner, seed_)])
     first = next(iter(rulebooks), None)
     main_label = "fuzzy-rrt" if "fuzzy-rrt" in rulebooks else first
     main_rb = rulebooks.get(main_label) if main_label else None
@@ -256,7 +275,7 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
                                "sha256": rb.sha256} for label, rb in rulebooks.items()]}
     return BenchResult(runs=runs_df, summary=summary, examples=examples, scenarios=by_name,
                        settings=settings, rulebook=main_rb, ratios=ratio_table(summary),
-                       rulebooks=dict(rulebooks))
+                       rulebooks=dict(rulebooks), worst_examples=worst)
 
 
 def _run_pool(jobs: list[_Job], workers: int, init_args: tuple, progress: Progress | None):

@@ -349,6 +349,9 @@ def load_bench_dir(folder: Path, rulebook: Path | None = None,
     meta = _read_json(folder / BENCH_JSON)
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise InputError(str(folder / BENCH_JSON), f"format: expected {FORMAT!r}")
+    from xfuzzy_rrt.bench.provenance import check_bench_json
+
+    check_bench_json(meta, folder / BENCH_JSON)
     runs = read_runs(folder / "runs.csv")
     summary = _read_csv(folder / "summary.csv")
     summary["scenario"] = summary["scenario"].astype(str)

@@ -101,14 +101,15 @@ def collect(command: str) -> dict[str, Any]:
 #: write). ``None`` marks a list whose items are checked with the named entry.
 BENCH_JSON_KEYS: dict[str, tuple[str, ...]] = {
     "": ("format", "format_version", "command", "date", "versions", "git", "machine",
-         "settings", "scenarios", "rulebook"),
+         "settings", "scenarios", "rulebook", "rulebooks"),
     "versions": ("xfuzzy-rrt", "python", *VERSION_DISTS),
     "git": ("commit", "dirty"),
     "machine": ("hostname", "system", "machine", "cpus"),
     "settings": ("runs", "seed", "max_iter", "planners", "shortcut", "workers", "rulebook",
-                 "rulebook_dir", "rulebook_sha256"),
+                 "rulebook_dir", "rulebook_sha256", "rulebooks"),
     "scenarios": ("name", "file", "sha256", "toml"),
     "rulebook": ("name", "dir", "sha256", "history"),
+    "rulebooks": ("planner", "name", "dir", "sha256", "history"),
 }
 
 
@@ -143,3 +144,6 @@ def check_bench_json(meta: dict[str, Any], path: str | os.PathLike[str]) -> None
     for entry in meta.get("scenarios") or []:
         if isinstance(entry, dict):
             check(entry, "scenarios")
+    for entry in meta.get("rulebooks") or []:
+        if isinstance(entry, dict):
+            check(entry, "rulebooks")

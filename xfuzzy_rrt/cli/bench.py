@@ -146,16 +146,14 @@ def demo(
     Two benchmarks, everything shipped in the package: (1) RRT vs Fuzzy-RRT with the default
     rulebook (``goal-frame``, trained on generated problems only) on the shipped demo scenarios
     and PROBLEMS fresh problems of the ``sample-*`` family that no training run saw (generator
-    seed 2000; the files are written to OUT/scenarios), into OUT; (2) RRT vs Fuzzy-RRT with the
-    ``paper`` rulebook on the paper's reference problem (the paper's setting), into
-    OUT/paper-reference.
+    seed 2000; the files are written to OUT/scenarios), into OUT; (2) on the paper's reference
+    problem, RRT, the default rulebook and the ``paper`` rulebook (the paper's setting) side by
+    side, into OUT/paper-reference.
     """
     from xfuzzy_rrt.atomic import write_text_atomic
-    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+    from xfuzzy_rrt.bench.runner import shipped_scenarios
     from xfuzzy_rrt.resources import paper_reference_scenario
     from xfuzzy_rrt.scenarios.generate import generate_one
-
-    from xfuzzy_rrt.bench.runner import shipped_scenarios
 
     files = list(shipped_scenarios())
     for k in range(problems):
@@ -168,8 +166,8 @@ def demo(
     for stale in sorted((out / "scenarios").glob("*.toml")):
         if stale not in files:  # from an earlier demo with more --problems
             stale.unlink()
-    code = max(code, _run([paper_reference_scenario()], "rrt,fuzzy-rrt", runs, 0,
-                          rulebooks_dir() / "paper", 10_000, out / "paper-reference", workers))
+    code = max(code, _run([paper_reference_scenario()], "rrt,fuzzy-rrt,fuzzy-rrt:paper", runs, 0,
+                          None, 10_000, out / "paper-reference", workers))
     return code
 
 

@@ -45,7 +45,7 @@ class _Progress:
             f"mean {row['mean_fitness']:9.1f}  median {row['median_fitness']:9.1f}  "
             f"best median iterations {row['best_median_iterations']:7.1f}  "
             + (f"validation {row['validation_fitness']:.4g}  "
-               if row.get("validation_fitness") == row.get("validation_fitness") else "") +
+               if "validation_fitness" in row else "") +
             f"{row['runs_per_s']:8.0f} runs/s  {row['wall_s']:6.2f} s  ETA <= {eta:5.0f} s")
 
     def phase(self, text: str) -> None:

@@ -54,6 +54,9 @@ class BenchResult:
     #: Where the numbers came from (command, date, versions, git, machine, file hashes);
     #: filled when the result is written to or read from a bench folder (``bench.store``).
     provenance: dict[str, Any] = field(default_factory=dict)
+    #: Per planner, the found run that came closest to an obstacle (or went deepest into one):
+    #: the certification evidence an auditor asks for (see :func:`worst_runs`).
+    worst: dict[str, PlanResult] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -139,6 +142,26 @@ def _median_run_seed(group: pd.DataFrame) -> int | None:
     return int(ok["seed"].iloc[int(np.argmin(np.abs(ok["iterations"].to_numpy() - target)))])
 
 
+def worst_run_keys(runs: pd.DataFrame) -> dict[str, tuple[str, int]]:
+    """Per planner, ``(scenario, seed)`` of the found run with the smallest ``min_clearance_m``
+    (the deepest ``penetration_m`` when clearances were not recorded); first in run order on
+    ties. Median runs never show the one path that grazed an obstacle; this one does."""
+    found = runs["found"] if "found" in runs.columns else runs["success"]
+    ok = runs[found.astype(bool)]
+    if "min_clearance_m" in ok.columns:
+        key = pd.to_numeric(ok["min_clearance_m"], errors="coerce")
+    elif "penetration_m" in ok.columns:
+        key = -pd.to_numeric(ok["penetration_m"], errors="coerce").fillna(0.0)
+    else:
+        return {}
+    out = {}
+    for planner, k in key.groupby(ok["planner"], sort=False):
+        if k.notna().any():
+            row = ok.loc[k.idxmin()]
+            out[str(planner)] = (str(row["scenario"]), int(row["seed"]))
+    return out
+
+
 def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50, seed: int = 0,
                   rulebook=None, max_iter: int = 10_000, workers: int = 1,
                   shortcut: bool = False, progress: Progress | None = None) -> BenchResult:
@@ -204,12 +227,14 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
             example = plan_scenario(by_name[scen], planner=planner, rulebook=rulebook,
                                     seed=seed_, max_iter=max_iter, trace=True)
         examples[(scen, planner)] = example
+    worst = {p: by_run[(scen, p, sd)] for p, (scen, sd) in worst_run_keys(runs_df).items()}
     settings = {"runs": runs, "seed": seed, "max_iter": max_iter, "planners": list(planners),
                 "shortcut": bool(shortcut), "workers": int(workers),
                 "rulebook": getattr(rulebook, "name", None), "rulebook_dir": rulebook_dir,
                 "rulebook_sha256": getattr(rulebook, "sha256", None)}
     return BenchResult(runs=runs_df, summary=summary, examples=examples, scenarios=by_name,
-                       settings=settings, rulebook=rulebook, ratios=ratio_table(summary))
+                       settings=settings, rulebook=rulebook, ratios=ratio_table(summary),
+                       worst=worst)
 
 
 def scenario_files(paths: list[Path]) -> list[Path]:

@@ -12,6 +12,8 @@ Layout (all written atomically, file by file)::
                           bookkeeping and path
     examples/eNN-tree.parquet   their search trees
     examples/eNN-trace.parquet  Fuzzy-RRT traces (what the drill-down explains)
+    examples/worst.json   per planner, the found run closest to (or deepest into) an obstacle:
+                          bookkeeping and path (the report's certification panel)
 
 Why the scenario text is copied into ``bench.json``: it is a few hundred bytes and makes the
 folder self-contained (the files may move or change after the benchmark; the SHA-256 records
@@ -38,6 +40,7 @@ FORMAT = "xfuzzy-rrt-bench"
 FORMAT_VERSION = 1
 BENCH_JSON = "bench.json"
 EXAMPLES = "examples"
+WORST_JSON = "worst.json"
 
 
 def _json(obj: Any) -> str:
@@ -150,6 +153,15 @@ def _write_examples(result: BenchResult, folder: Path) -> None:
             "tree": f"{stem}-tree.parquet", "trace": trace_file,
         })
     write_text_atomic(folder / "index.json", _json(_plain(index)))
+    # The worst-clearance found run of each planner (the report's certification panel): the
+    # path only, no tree.
+    worst = [{"planner": p, "scenario": r.scenario, "seed": int(r.seed),
+              "success": bool(r.success), "iterations": int(r.iterations), "nodes": int(r.nodes),
+              "cost_deg": r.cost_deg, "wall_s": float(r.wall_s), "rulebook": r.rulebook,
+              "rulebook_sha256": r.rulebook_sha256, "params": _plain(dict(r.params or {})),
+              "path_deg": np.asarray(r.path_deg, dtype=np.float64).tolist()}
+             for p, r in getattr(result, "worst", {}).items()]
+    write_text_atomic(folder / WORST_JSON, _json(_plain(worst)))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -246,11 +258,29 @@ def load_bench_dir(folder: Path, rulebook: Path | None = None,
             raise InputError(str(history), "no such file")
     examples = _read_examples(folder / EXAMPLES)
     result = BenchResult(runs=runs, summary=summary, examples=examples, scenarios=scenarios,
-                         settings=dict(meta.get("settings") or {}), rulebook=rb, ratios=ratios)
+                         settings=dict(meta.get("settings") or {}), rulebook=rb, ratios=ratios,
+                         worst=_read_worst(folder / EXAMPLES / WORST_JSON))
     result = _with_provenance(result, meta)
     if history is not None:
         result.provenance["history"] = str(Path(history).resolve())
     return result
+
+
+def _read_worst(path: Path) -> dict[str, PlanResult]:
+    """The worst-clearance runs (absent in folders written before they were stored)."""
+    if not path.is_file():
+        return {}
+    out = {}
+    for e in _read_json(path):
+        out[str(e["planner"])] = PlanResult(
+            scenario=str(e["scenario"]), planner=str(e["planner"]), seed=int(e["seed"]),
+            success=bool(e["success"]), iterations=int(e["iterations"]), nodes=int(e["nodes"]),
+            cost_deg=e["cost_deg"], wall_s=float(e["wall_s"]),
+            path_deg=np.asarray(e["path_deg"], dtype=np.float64).reshape(-1, 2),
+            tree_nodes_deg=np.empty((0, 2)), tree_parent=np.empty(0, dtype=np.int64),
+            rulebook=e.get("rulebook"), rulebook_sha256=e.get("rulebook_sha256"),
+            params=dict(e.get("params") or {}))
+    return out
 
 
 def _read_examples(folder: Path) -> dict[tuple[str, str], PlanResult]:

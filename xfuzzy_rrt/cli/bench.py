@@ -38,15 +38,13 @@ class ProgressBar:
 
 
 def write_outputs(result, out: Path, command: str):
-    """Write the tables, bench.json, the example runs and report.html into ``out``."""
-    from xfuzzy_rrt.atomic import atomic_path
+    """Write the tables, bench.json, the example runs, report.html and report/ into ``out``."""
     from xfuzzy_rrt.bench.provenance import collect
     from xfuzzy_rrt.bench.store import write_bench_dir
-    from xfuzzy_rrt.report.bench_report import write_bench_report
+    from xfuzzy_rrt.report.site import write_report
 
     result = write_bench_dir(result, out, collect(command))
-    with atomic_path(out / "report.html") as tmp:
-        write_bench_report(result, tmp, command=command)
+    write_report(result, out, command=command)
     return result
 
 

@@ -500,7 +500,7 @@ def _follow_one_plan(page: Page, idx: int, s, run, rulebook, grid, settings: dic
                  anchor=f"follow-{idx}")
     plan = _plan_cmd(s, "fuzzy-rrt", run.seed, settings)
     page.add(page.figure(firing_heatmap(trace, rulebook), f"fig-s{idx}-firing"))
-    page.add(page.figure(io_series(trace), f"fig-s{idx}-io"))
+    page.add(page.figure(io_series(trace, rulebook=rulebook), f"fig-s{idx}-io"))
     page.add(_reproduce_line(f"{plan} --trace trace.parquet"))
     its = select_iterations(trace, per_scenario(n_drill))
     if not its:
@@ -536,12 +536,14 @@ def _influence_table(run, rulebook, k: int = 3) -> str:
     from xfuzzy_rrt.analysis.firing import top_rules
     from xfuzzy_rrt.fuzzy.text_format import rule_sentence
     from xfuzzy_rrt.fuzzy.variables import OUTPUTS
+    from xfuzzy_rrt.report.numbers import readable_numbers
 
     top = top_rules(run.trace, k=k)
     rows = []
     for _, row in top.iterrows():
         fis = rulebook.systems[OUTPUTS.index(row["output"])]
-        rows.append((row["output"], f"r{int(row['rule'])}", rule_sentence(fis, int(row["rule"])),
+        rows.append((row["output"], f"r{int(row['rule'])}",
+                     readable_numbers(rule_sentence(fis, int(row["rule"]))),
                      f"{100 * row['share']:.1f}%", int(row["iterations_fired"])))
     intro = (f"<p>Rules that drove the example Fuzzy-RRT run (seed {int(run.seed)}, "
              f"{int(run.iterations)} iterations): for each output, the {k} rules with the largest "

@@ -166,10 +166,18 @@ window.XF = (function () {
     }
     return v;
   }
+  // plotly.js may arrive after this script (loaded async from the report folder).
+  var plotly = window.Plotly ? Promise.resolve() : new Promise(function (ok) { window.__xfPlotly = ok; });
   function render(id) {
     if (done[id] || !figs[id]) return done[id] || null;
     var f = resolve(figs[id]);
-    done[id] = Plotly.newPlot(id, f.data, f.layout, f.config);
+    done[id] = plotly.then(function () { return Plotly.newPlot(id, f.data, f.layout, f.config); }).then(function (gd) {
+      if (f.links) gd.on('plotly_click', function (e) {
+        var u = e.points && e.points[0] && e.points[0].customdata;
+        if (typeof u === 'string' && u) window.location.href = u;
+      });
+      return gd;
+    });
     return done[id];
   }
   function renderAll() { return Promise.all(Object.keys(figs).map(render)); }
@@ -180,6 +188,7 @@ window.XF = (function () {
     Object.keys(figs).forEach(function (id) { var el = document.getElementById(id); if (el) io.observe(el); });
   } else { renderAll(); }
   window.addEventListener('beforeprint', renderAll);
-  return {render: render, renderAll: renderAll, resolve: resolve, figs: figs, done: done};
+  return {render: render, renderAll: renderAll, resolve: resolve, figs: figs, done: done,
+          plotly: plotly};
 })();
 """

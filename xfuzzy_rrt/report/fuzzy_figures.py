@@ -6,7 +6,7 @@
   share the same partitions);
 - :func:`surface_figure` -- each output over two chosen inputs, the other two fixed;
 - :func:`training_figure` -- best / mean / median fitness per generation;
-- :func:`ratio_figure` -- per planner, the per-scenario median-iteration ratios to the baseline.
+- :func:`coverage_figure` -- how many rules fired over the traced runs, and how few decide.
 
 Dense traces are decimated for drawing (a run may have 10,000 iterations; a browser plot needs
 a few hundred columns): heatmap columns are *bins* of consecutive iterations showing the mean
@@ -25,8 +25,8 @@ import pandas as pd
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from xfuzzy_rrt.fuzzy.variables import INPUTS, MAX_FIRED, OUTPUTS, rule_terms
-from xfuzzy_rrt.report.figures import TEMPLATE, plot_text, planner_color, planner_label
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, rule_terms
+from xfuzzy_rrt.report.figures import TEMPLATE, plot_text
 
 MAX_HEATMAP_COLUMNS = 80
 MAX_HEATMAP_RULES = 24
@@ -156,13 +156,12 @@ def io_series(trace: pd.DataFrame, max_points: int = MAX_SERIES_POINTS,
     view = trace.iloc[::step]
     inputs, outputs, _, _, units = semantics(rulebook)
     names = [c for c in list(inputs) + list(outputs) if c in trace.columns]
-    INPUTS = inputs  # noqa: N806 (the loop below colours inputs and outputs apart)
     fig = make_subplots(rows=max(1, math.ceil(len(names) / 2)), cols=2, shared_xaxes=True,
                         vertical_spacing=0.05, horizontal_spacing=0.08,
                         subplot_titles=[with_unit(c, units) for c in names])
     x = view["iteration"].to_numpy(dtype=np.int32)
     for k, c in enumerate(names):
-        is_input = c in INPUTS
+        is_input = c in inputs
         fig.add_trace(go.Scatter(x=x, y=view[c].to_numpy(dtype=np.float64), mode="lines",
                                    name=c, showlegend=False,
                                    line=dict(width=1, color="#0072B2" if is_input else "#D55E00"),
@@ -338,32 +337,4 @@ def training_figure(history: pd.DataFrame) -> go.Figure:
     fig.update_layout(template=TEMPLATE, height=380, xaxis_title="generation",
                       yaxis_title="fitness", margin=dict(l=60, r=20, t=50, b=50),
                       title=dict(text="Training: fitness per generation", x=0))
-    return fig
-
-
-def ratio_figure(summary: pd.DataFrame, baseline: str = "rrt") -> go.Figure | None:
-    """Per planner, one dot per scenario: baseline median iterations / planner median."""
-    from xfuzzy_rrt.bench.summary import scenario_ratios
-    from xfuzzy_rrt.report.figures import planner_order
-
-    r = summary.assign(_r=scenario_ratios(summary, baseline))
-    r = r[(r["planner"] != baseline) & r["_r"].notna()]
-    if r.empty:
-        return None
-    fig = go.Figure()
-    for p in planner_order(r["planner"]):
-        g = r[r["planner"] == p]
-        fig.add_trace(go.Box(x=g["_r"].to_numpy(dtype=np.float64), name=plot_text(planner_label(p)),
-                             boxpoints="all", jitter=0.4, pointpos=0, orientation="h",
-                             marker=dict(color=planner_color(p), size=6),
-                             line=dict(color=planner_color(p)), fillcolor="rgba(0,0,0,0)",
-                             text=[plot_text(s) for s in g["scenario"]],
-                             hovertemplate="%{text}: %{x:.2f}<extra>" + plot_text(p) + "</extra>"))
-    fig.add_vline(x=1.0, line=dict(color="#444", dash="dash"))
-    fig.update_xaxes(type="log", title_text=f"{planner_label(baseline)} median iterations / "
-                     "planner median iterations (log; > 1: fewer iterations than the baseline)")
-    fig.update_layout(template=TEMPLATE, height=150 + 60 * r["planner"].nunique(),
-                      showlegend=False, margin=dict(l=110, r=20, t=50, b=60),
-                      title=dict(text="Per-scenario median-iteration ratio to "
-                                      f"{planner_label(baseline)}", x=0))
     return fig

@@ -113,26 +113,35 @@ class Names:
 def write_report(result, folder: Path, command: str | None = None,
                  generated_at: str | None = None) -> Path:
     """Write ``folder/report.html`` and ``folder/report/`` (pages and plotly.js); return the
-    entry page. The previous report is replaced as a set."""
-    folder = Path(folder)
-    pages = build_pages(result, command=command, generated_at=generated_at, folder=folder)
+    entry page.
+
+    The evidence folder is written complete under a hidden name (``.report-XXXX.tmp``) and
+    swapped in; the entry page goes through :func:`~xfuzzy_rrt.atomic.atomic_path`. So an
+    interrupted run leaves the previous report or the new one, never a mix; hidden staging
+    folders left by a killed run are removed by the next one.
+    """
     from plotly.offline import get_plotlyjs
 
-    stage = Path(tempfile.mkdtemp(prefix=".report-", dir=folder))
+    from xfuzzy_rrt.atomic import atomic_path
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    pages = build_pages(result, command=command, generated_at=generated_at, folder=folder)
+    for stale in folder.glob(".report-*.tmp"):
+        shutil.rmtree(stale, ignore_errors=True)
+    stage = Path(tempfile.mkdtemp(prefix=".report-", suffix=".tmp", dir=folder))
     try:
         (stage / ASSETS).mkdir()
         (stage / ASSETS / PLOTLY_JS).write_text(get_plotlyjs(), encoding="utf-8")
         for rel, text in pages.items():
-            (stage / rel).write_text(text, encoding="utf-8", newline="\n")
-        old = folder / ASSETS
-        trash = None
-        if old.exists():
-            trash = Path(tempfile.mkdtemp(prefix=".report-old-", dir=folder))
-            os.replace(old, trash / ASSETS)
-        os.replace(stage / ASSETS, old)
-        os.replace(stage / ENTRY, folder / ENTRY)
-        if trash is not None:
-            shutil.rmtree(trash, ignore_errors=True)
+            if rel != ENTRY:
+                (stage / rel).write_text(text, encoding="utf-8", newline="\n")
+        with atomic_path(folder / ENTRY) as tmp:
+            tmp.write_text(pages[ENTRY], encoding="utf-8", newline="\n")
+            old = folder / ASSETS
+            if old.exists():
+                os.replace(old, stage / "old")
+            os.replace(stage / ASSETS, old)
     finally:
         shutil.rmtree(stage, ignore_errors=True)
     return folder / ENTRY
@@ -395,7 +404,7 @@ METRICS_NOTE = (
 
 
 def _provenance(ctx, page: Page) -> None:
-    from xfuzzy_rrt.report.bench_report import _versions
+    from xfuzzy_rrt.report.evidence import _versions
 
     prov, settings = ctx["prov"], ctx["settings"]
     page.add(f"<pre>{esc(ctx['command'])}</pre>")
@@ -452,7 +461,7 @@ def _plan_cmd(ctx, s, planner: str, seed: int) -> str:
 
 
 def _scenario_page(ctx, idx: int, name: str) -> str:
-    from xfuzzy_rrt.report.bench_report import _scenario_details
+    from xfuzzy_rrt.report.evidence import _scenario_details
 
     result, planners = ctx["result"], ctx["planners"]
     page = Page(f"Scenario {name}")
@@ -512,7 +521,7 @@ def _scenario_page(ctx, idx: int, name: str) -> str:
         r = examples.get(p)
         if rb is None or r is None or not _followable(r, rb):
             continue
-        from xfuzzy_rrt.report.bench_report import _follow_one_plan, _influence_table
+        from xfuzzy_rrt.report.evidence import _follow_one_plan, _influence_table
 
         page.heading(f"Follow one plan: {F.planner_label(p)}", anchor=f"follow-{slug(p)}")
         page.add(_influence_table(r, rb))

@@ -1,6 +1,7 @@
 """The on-disk bench folder: everything ``xfuzzy-rrt report DIR`` needs, without re-planning.
 
-Layout (all written atomically, file by file)::
+Layout (written into a hidden sibling folder, then swapped in as a whole -- see
+:func:`staged_folder` -- so a folder never mixes two benchmarks' files)::
 
     runs.csv              one row per run (SPEC.md columns + certified, penetration_m, ...)
     summary.csv           one row per (scenario, planner), recomputable from runs.csv
@@ -23,10 +24,16 @@ not worth copying): rebuilding the report checks that the rulebook found is the 
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
+import secrets
+import shutil
+import signal
+import tempfile
 import tomllib
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable, Iterator
 
 import numpy as np
 import pandas as pd
@@ -93,8 +100,13 @@ def bench_json(result: BenchResult, provenance: dict[str, Any]) -> dict[str, Any
         rb = {"name": result.rulebook.name, "dir": settings.get("rulebook_dir"),
               "sha256": result.rulebook.sha256,
               "history": history_path(result.rulebook, settings.get("rulebook_dir"))}
+    dirs = {e["planner"]: e.get("dir") for e in settings.get("rulebooks") or []}
+    rulebooks = [{"planner": label, "name": book.name, "dir": dirs.get(label),
+                  "sha256": book.sha256, "history": history_path(book, dirs.get(label))}
+                 for label, book in (result.rulebooks or {}).items()]
     return _plain({"format": FORMAT, "format_version": FORMAT_VERSION, **provenance,
-                   "settings": settings, "scenarios": scenarios, "rulebook": rb})
+                   "settings": settings, "scenarios": scenarios, "rulebook": rb,
+                   "rulebooks": rulebooks})
 
 
 def write_bench_dir(result: BenchResult, out: Path, provenance: dict[str, Any]) -> BenchResult:
@@ -146,7 +158,9 @@ def _write_examples(result: BenchResult, folder: Path) -> None:
                 r.trace.to_parquet(tmp, index=False)
         index.append({
             "scenario": scen, "planner": planner, "seed": int(r.seed), "success": bool(r.success),
-            "iterations": int(r.iterations), "nodes": int(r.nodes), "cost_deg": r.cost_deg,
+            "found": bool(r.found), "certified": bool(r.certified),
+            "min_clearance_m": r.min_clearance_m, "penetration_m": r.penetration_m,
+            "violation": r.violation, "iterations": int(r.iterations), "nodes": int(r.nodes), "cost_deg": r.cost_deg,
             "wall_s": float(r.wall_s), "rulebook": r.rulebook,
             "rulebook_sha256": r.rulebook_sha256, "params": _plain(dict(r.params or {})),
             "path_deg": np.asarray(r.path_deg, dtype=np.float64).tolist(),
@@ -156,12 +170,121 @@ def _write_examples(result: BenchResult, folder: Path) -> None:
     # The worst-clearance found run of each planner (the report's certification panel): the
     # path only, no tree.
     worst = [{"planner": p, "scenario": r.scenario, "seed": int(r.seed),
-              "success": bool(r.success), "iterations": int(r.iterations), "nodes": int(r.nodes),
+              "found": bool(r.found), "certified": bool(r.certified),
+              "min_clearance_m": r.min_clearance_m, "penetration_m": r.penetration_m,
+              "violation": r.violation, "iterations": int(r.iterations), "nodes": int(r.nodes),
               "cost_deg": r.cost_deg, "wall_s": float(r.wall_s), "rulebook": r.rulebook,
               "rulebook_sha256": r.rulebook_sha256, "params": _plain(dict(r.params or {})),
               "path_deg": np.asarray(r.path_deg, dtype=np.float64).tolist()}
              for p, r in getattr(result, "worst", {}).items()]
     write_text_atomic(folder / WORST_JSON, _json(_plain(worst)))
+
+
+# ----------------------------------------------------------------------------------------------
+# Replacing a folder as a set
+# ----------------------------------------------------------------------------------------------
+
+def _nearest_existing(path: Path) -> Path:
+    path = Path(os.path.abspath(path))
+    while not path.exists() and path != path.parent:
+        path = path.parent
+    return path
+
+
+def check_out_dir(out: Path, inputs: Iterable[Path] = (), keep: Iterable[str] = ()) -> None:
+    """Refuse, before any planning, an ``--out`` the bench could not (or must not) replace.
+
+    ``out`` must be a directory or not exist; an existing one must be empty or a bench folder
+    (it holds ``bench.json``), because a bench replaces the whole folder and must never delete
+    files it did not write -- entries named in ``keep`` (e.g. the demo's ``scenarios``) are
+    carried over and exempt. For the same reason no input file may lie inside it, outside
+    ``keep``. Whether the place is writable is checked by :func:`staged_folder`, which creates
+    the new folder's sibling at once.
+    """
+    out = Path(out)
+    keep = set(keep)
+    if out.exists() and not out.is_dir():
+        raise InputError(str(out), "exists and is not a directory (--out names a folder)")
+    if out.is_dir():
+        try:
+            entries = [e for e in out.iterdir() if e.name not in keep]
+        except OSError as exc:
+            raise InputError(str(out), f"cannot read: {exc.strerror or exc}") from None
+        if entries and not (out / BENCH_JSON).is_file():
+            raise InputError(str(out), "is not empty and not a bench folder (no bench.json); "
+                             "a bench replaces its output folder as a whole, so choose a new "
+                             "or empty folder")
+    root = out.resolve()
+    for p in inputs:
+        p = Path(p).resolve()
+        if root in p.parents and p.relative_to(root).parts[0] not in keep:
+            raise InputError(str(p), f"lies inside --out {out}, which the bench replaces; "
+                             "move it or choose another --out")
+
+
+@contextlib.contextmanager
+def staged_folder(out: Path, keep: Iterable[str] = ()) -> Iterator[Path]:
+    """Yield an empty hidden folder beside ``out``; on success it *becomes* ``out``.
+
+    Why: a bench folder is one consistent set of files (tables, examples, report). Writing them
+    in place, a second bench into the same folder would leave stale ``examples/`` beside new
+    tables, and an interruption would mix two benchmarks. Here everything is written into the
+    hidden sibling; only when the block succeeds are the ``keep`` entries of the old folder
+    moved into it and the old folder swapped out by two renames (Ctrl-C is held back during the
+    swap, so the result is the previous complete folder or the new one). On any failure,
+    Ctrl-C included, the sibling is removed and ``out`` is untouched.
+
+    The sibling is created at once, so an unwritable ``out`` fails here, before any planning,
+    with one error naming ``out`` (not the hidden folder).
+    """
+    out = Path(out)
+    keep = tuple(keep)
+    anchor = _nearest_existing(out.parent)
+    if not anchor.is_dir():
+        raise InputError(str(out), f"cannot create it: {anchor} is not a directory")
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".staging", dir=anchor))
+    except OSError as exc:
+        raise InputError(str(out), f"cannot write here: {exc.strerror or exc}") from None
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(stage, 0o777 & ~umask)
+        yield stage
+        _swap_in(stage, out, keep)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+
+
+def _swap_in(stage: Path, out: Path, keep: tuple[str, ...]) -> None:
+    """Make ``stage`` the folder ``out`` (the old one's ``keep`` entries carried over)."""
+    old_mask = None
+    with contextlib.suppress(AttributeError, ValueError):
+        old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        try:
+            out.parent.mkdir(parents=True, exist_ok=True)
+            if stage.parent.resolve() != out.parent.resolve():
+                moved = out.parent / stage.name
+                os.rename(stage, moved)
+                stage = moved
+            if out.is_dir():
+                for name in keep:
+                    if (out / name).exists() and not (stage / name).exists():
+                        os.rename(out / name, stage / name)
+                old = out.parent / f".{out.name}.{secrets.token_hex(4)}.old"
+                os.rename(out, old)
+                os.rename(stage, out)
+                shutil.rmtree(old, ignore_errors=True)
+            else:
+                os.rename(stage, out)
+        except OSError as exc:
+            shutil.rmtree(stage, ignore_errors=True)
+            raise InputError(str(out), f"cannot replace it: {exc.strerror or exc}") from None
+    finally:
+        if old_mask is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -194,8 +317,9 @@ def read_runs(path: Path) -> pd.DataFrame:
         raise InputError(str(path), f"missing column(s) {', '.join(missing)}")
     runs["scenario"] = runs["scenario"].astype(str)
     runs["success"] = runs["success"].astype(bool)
-    if "certified" in runs:
-        runs["certified"] = runs["certified"].astype("boolean")
+    for col in ("found", "certified"):
+        if col in runs:
+            runs[col] = runs[col].astype("boolean").fillna(False).astype(bool)
     return runs
 
 
@@ -243,27 +367,40 @@ def load_bench_dir(folder: Path, rulebook: Path | None = None,
     rb = None
     rb_meta = meta.get("rulebook")
     if rb_meta:
-        from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
-
-        rb_dir = rulebook if rulebook is not None else rb_meta.get("dir")
-        if not rb_dir or not Path(rb_dir).is_dir():
-            raise InputError(str(rb_dir or where), "the rulebook this benchmark used is not "
-                             "there; pass its directory with --rulebook")
-        rb = load_rulebook(rb_dir)
-        if rb.sha256 != rb_meta.get("sha256"):
-            raise InputError(str(rb_dir), f"rulebook sha256 {rb.sha256[:12]}… is not the one "
-                             f"this benchmark used ({str(rb_meta.get('sha256'))[:12]}…)")
+        rb = _load_recorded_rulebook(rb_meta, rulebook, where)
+    rulebooks = {}
+    for entry in meta.get("rulebooks") or []:
+        if rb is not None and entry.get("sha256") == rb.sha256:
+            rulebooks[entry["planner"]] = rb
+        else:
+            rulebooks[entry["planner"]] = _load_recorded_rulebook(entry, None, where)
     if history is not None:
         if not Path(history).is_file():
             raise InputError(str(history), "no such file")
     examples = _read_examples(folder / EXAMPLES)
     result = BenchResult(runs=runs, summary=summary, examples=examples, scenarios=scenarios,
                          settings=dict(meta.get("settings") or {}), rulebook=rb, ratios=ratios,
+                         rulebooks=rulebooks,
                          worst=_read_worst(folder / EXAMPLES / WORST_JSON))
     result = _with_provenance(result, meta)
     if history is not None:
         result.provenance["history"] = str(Path(history).resolve())
     return result
+
+
+def _load_recorded_rulebook(entry: dict[str, Any], override, where: str):
+    """The rulebook a bench recorded, found at its directory (or ``override``) with its SHA-256."""
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+
+    rb_dir = override if override is not None else entry.get("dir")
+    if not rb_dir or not Path(rb_dir).is_dir():
+        raise InputError(str(rb_dir or where), "the rulebook this benchmark used is not "
+                         "there; pass its directory with --rulebook")
+    rb = load_rulebook(rb_dir)
+    if rb.sha256 != entry.get("sha256"):
+        raise InputError(str(rb_dir), f"rulebook sha256 {rb.sha256[:12]}… is not the one "
+                         f"this benchmark used ({str(entry.get('sha256'))[:12]}…)")
+    return rb
 
 
 def _read_worst(path: Path) -> dict[str, PlanResult]:
@@ -274,7 +411,9 @@ def _read_worst(path: Path) -> dict[str, PlanResult]:
     for e in _read_json(path):
         out[str(e["planner"])] = PlanResult(
             scenario=str(e["scenario"]), planner=str(e["planner"]), seed=int(e["seed"]),
-            success=bool(e["success"]), iterations=int(e["iterations"]), nodes=int(e["nodes"]),
+            found=bool(e["found"]), certified=bool(e["certified"]),
+            min_clearance_m=e.get("min_clearance_m"), penetration_m=e.get("penetration_m"),
+            violation=e.get("violation"), iterations=int(e["iterations"]), nodes=int(e["nodes"]),
             cost_deg=e["cost_deg"], wall_s=float(e["wall_s"]),
             path_deg=np.asarray(e["path_deg"], dtype=np.float64).reshape(-1, 2),
             tree_nodes_deg=np.empty((0, 2)), tree_parent=np.empty(0, dtype=np.int64),
@@ -293,9 +432,14 @@ def _read_examples(folder: Path) -> dict[tuple[str, str], PlanResult]:
         except Exception as exc:  # missing or unreadable parquet
             raise InputError(str(folder), f"example {e.get('tree')}: cannot read: {exc}") from None
         path = np.asarray(e["path_deg"], dtype=np.float64).reshape(-1, 2)
+        # Folders written before found/certified existed: their "success" meant "found", and
+        # only certified examples were drawn.
+        found = bool(e.get("found", e["success"]))
         out[(str(e["scenario"]), str(e["planner"]))] = PlanResult(
             scenario=str(e["scenario"]), planner=str(e["planner"]), seed=int(e["seed"]),
-            success=bool(e["success"]), iterations=int(e["iterations"]), nodes=int(e["nodes"]),
+            found=found, certified=found and bool(e.get("certified", e["success"])),
+            min_clearance_m=e.get("min_clearance_m"), penetration_m=e.get("penetration_m"),
+            violation=e.get("violation"), iterations=int(e["iterations"]), nodes=int(e["nodes"]),
             cost_deg=e["cost_deg"], wall_s=float(e["wall_s"]), path_deg=path,
             tree_nodes_deg=tree[["q1_deg", "q2_deg"]].to_numpy(dtype=np.float64),
             tree_parent=tree["parent"].to_numpy(dtype=np.int64), rulebook=e.get("rulebook"),

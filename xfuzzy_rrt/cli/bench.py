@@ -38,42 +38,65 @@ class ProgressBar:
 
 
 def write_outputs(result, out: Path, command: str):
-    """Write the tables, bench.json, the example runs, report.html and report/ into ``out``."""
+    """Write the tables, bench.json, the example runs, report.html and report/ into ``out``
+    (the staged folder; :func:`xfuzzy_rrt.bench.store.staged_folder` swaps it in)."""
     from xfuzzy_rrt.bench.provenance import collect
     from xfuzzy_rrt.bench.store import write_bench_dir
+    from xfuzzy_rrt.cli.common import test_signal
     from xfuzzy_rrt.report.site import write_report
 
     result = write_bench_dir(result, out, collect(command))
+    test_signal("tables")
     write_report(result, out, command=command)
+    test_signal("report")
     return result
 
 
 def _render_summary(summary) -> str:
-    cols = ["scenario", "planner", "success_rate", "iterations_min", "iterations_median",
-            "iterations_max", "cost_median", "wall_median_s", "certified_fraction"]
+    cols = ["scenario", "planner", "success_rate", "found_rate", "iterations_min",
+            "iterations_median", "iterations_max", "cost_median", "wall_median_s",
+            "certified_fraction", "min_clearance_min_m"]
     if "cost_short_median" in summary.columns:
-        cols.insert(7, "cost_short_median")
+        cols.insert(8, "cost_short_median")
     view = summary[[c for c in cols if c in summary.columns]].copy()
     view["wall_median_ms"] = view.pop("wall_median_s") * 1e3
+    if "min_clearance_min_m" in view:
+        view["min_clearance_mm"] = view.pop("min_clearance_min_m") * 1e3
     return view.to_string(index=False, float_format=lambda x: f"{x:.3f}")
 
 
 def _run(scenarios: List[Path], planners: str, runs: int, seed: int, rulebook: Optional[Path],
-         max_iter: int, out: Path, workers: int, shortcut: bool = False) -> int:
+         max_iter: int, out: Path, workers: int, shortcut: bool = False,
+         keep: tuple[str, ...] = ()) -> int:
+    """Plan and write one bench folder, replaced as a set (``keep``: entries of an existing
+    folder to carry over, e.g. the demo's scenarios). Ctrl-C: one line, the previous folder
+    (or none) stays, exit 130."""
     from xfuzzy_rrt.bench.runner import check_planners, run_benchmark, scenario_files
-    from xfuzzy_rrt.cli.common import load_scenario_warn
+    from xfuzzy_rrt.bench.store import check_out_dir, staged_folder
+    from xfuzzy_rrt.cli.common import load_scenario_warn, test_signal
 
-    from xfuzzy_rrt.errors import InputError
-
-    if out.exists() and not out.is_dir():  # fail before planning, not after
-        raise InputError(str(out), "exists and is not a directory (--out names a folder)")
     names = check_planners([p.strip() for p in planners.split(",") if p.strip()])
-    loaded = [load_scenario_warn(p) for p in scenario_files(scenarios)]
-    result = run_benchmark(loaded, names, runs=runs, seed=seed, rulebook=rulebook,
-                           max_iter=max_iter, workers=workers, shortcut=shortcut,
-                           progress=ProgressBar())
+    files = scenario_files(scenarios)
+    check_out_dir(out, files, keep)  # fail before planning, not after
+    loaded = [load_scenario_warn(p) for p in files]
+    bar = ProgressBar()
+
+    def progress(done: int, total: int) -> None:
+        bar(done, total)
+        test_signal(f"runs:{done}")
+
     command = "xfuzzy-rrt " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-    write_outputs(result, out, command)
+    try:
+        with staged_folder(out, keep) as stage:
+            result = run_benchmark(loaded, names, runs=runs, seed=seed, rulebook=rulebook,
+                                   max_iter=max_iter, workers=workers, shortcut=shortcut,
+                                   progress=progress)
+            write_outputs(result, stage, command)
+    except KeyboardInterrupt:
+        state = "the previous folder is unchanged" if out.exists() else "nothing was written"
+        sys.stderr.write(f"\ninterrupted: {out}: {state}\n")
+        sys.stderr.flush()
+        raise
     typer.echo(_render_summary(result.summary))
     if result.ratios is not None and len(result.ratios):
         typer.echo(result.ratios.to_string(index=False, float_format=lambda x: f"{x:.3f}"))
@@ -88,11 +111,15 @@ def _default_out(prefix: str) -> Path:
 
 def bench(
     scenarios: List[Path] = typer.Argument(..., help="Scenario TOML files or directories of them."),
-    planners: str = typer.Option("rrt,fuzzy-rrt", "--planners",
-                                 help="Comma list: rrt, fuzzy-rrt, ompl:NAME (e.g. ompl:RRTConnect)."),
+    planners: str = typer.Option(
+        "rrt,fuzzy-rrt", "--planners",
+        help="Comma list: rrt, fuzzy-rrt (the --rulebook or default rulebook), "
+             "fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR (a rulebook directory; "
+             "several side by side), ompl:NAME (e.g. ompl:RRTConnect)."),
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),
     seed: int = typer.Option(0, "--seed", help="First seed; run k uses seed + k."),
-    rulebook: Optional[Path] = typer.Option(None, "--rulebook", help="Rulebook directory."),
+    rulebook: Optional[Path] = typer.Option(None, "--rulebook",
+                                            help="Rulebook directory of plain fuzzy-rrt."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Output folder (default reports/bench-<time>)."),
     workers: int = typer.Option(1, "--workers", min=1, help="Worker processes."),
@@ -128,7 +155,8 @@ def demo(
         path = out / "scenarios" / f"{problem.scenario.name}.toml"
         write_text_atomic(path, problem.text)
         files.append(path)
-    code = _run(files, "rrt,fuzzy-rrt", runs, 0, None, 10_000, out, workers)
+    code = _run(files, "rrt,fuzzy-rrt", runs, 0, None, 10_000, out, workers,
+                keep=("scenarios", "paper-reference"))
     reference = rulebooks_dir().parent.parent / "shared" / "scenarios" / "paper-reference.toml"
     paper = rulebooks_dir() / "paper"
     if reference.is_file() and paper.is_dir():

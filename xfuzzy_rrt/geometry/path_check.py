@@ -12,13 +12,8 @@ Two independent measurements:
 - ``certified``: every vertex within the joint limits and every segment accepted by the
   certified check :func:`~xfuzzy_rrt.geometry.collision.edge_free` (conservative advancement,
   same ``margin`` as the planners). This is the yes/no the planners themselves are held to.
-- ``penetration_m``: a dense scan of every segment with *signed* exact distances. Samples are
-  spaced so that no point of the arm moves more than ``scan_step_m`` (0.1 mm) between two of
-  them, using the same motion bound ``M = max_k M_k`` as the certified check (see
-  ``collision.py``); where the clearance ``c`` exceeds that step the scan jumps by ``c / M``
-  instead, which provably skips no contact. At each sample the signed clearance is ``min over
-  links and obstacles of (signed distance - link_radius)`` and the penetration is
-  ``max(0, -signed clearance)``; the path's value is the maximum over all samples.
+- ``min_clearance_m`` / ``penetration_m``: the exact smallest *signed* clearance over every
+  configuration on the path (below), and the depth ``max(0, -min_clearance_m)``.
 
 The distance is *signed* so that the depth does not saturate once a link's centre line touches
 an obstacle (the unsigned clearance used for planning bottoms out at ``-link_radius``). Inside,
@@ -27,6 +22,17 @@ the obstacle: for a circle ``dist(centre, segment) - r``; for a box the smallest
 three separating axes of a segment and a rectangle (x, y and the segment's normal), which is
 exact for two convex polygons in the plane (separating axis theorem). Outside, it is the
 ordinary exact distance, so the two checks agree on every free configuration.
+
+``min_clearance_m`` is the smallest of these signed clearances over the whole path (negative:
+the exact penetration depth), found by Lipschitz branch and bound instead of a scan. Along a
+segment the signed clearance ``c(s)`` changes by at most ``M`` per unit ``s`` (``M = max_k
+M_k``, the motion bound of the certified check in ``collision.py``: no point of any link moves farther, and a signed distance to a convex obstacle
+moves no more than the segment does), so on an interval ``[s0, s1]`` with end values
+``c0, c1`` nothing is smaller than ``(c0 + c1 - M (s1 - s0)) / 2``. Intervals whose bound
+cannot beat the best value seen by more than ``MIN_CLEARANCE_TOL_M`` (1 nm) are dropped, the
+others are halved. The value returned is an exact distance at a real configuration on the path
+(``min_config_deg``), and no configuration on the path is closer by more than 1 nm.
+``penetration_m`` is ``max(0, -min_clearance_m)``.
 """
 
 from __future__ import annotations
@@ -46,8 +52,12 @@ from xfuzzy_rrt.geometry.collision import (
     within_limits,
 )
 
-#: Largest motion (metres) of any point of the arm between two samples of the penetration scan.
-SCAN_STEP_M = 1e-4
+#: The exact minimum clearance along a path is bracketed to within this (metres).
+MIN_CLEARANCE_TOL_M = 1e-9
+#: Distance evaluations per path after which the branch and bound stops refining and reports
+#: its proven lower bound instead (only reached when the clearance stays within 1 nm of its
+#: minimum over a long stretch, e.g. a link turning about the centre of a circle).
+MIN_CLEARANCE_MAX_EVALS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -63,6 +73,30 @@ class PathCheck:
     certified: bool
     penetration_m: float
     worst_segment: int
+    #: Exact smallest signed clearance along the path (``inf`` without obstacles, ``nan``
+    #: without a path); negative values are penetration depths.
+    min_clearance_m: float = math.nan
+    #: Where it occurs: the segment (``path[i] -> path[i + 1]``; 0 for a one-point path) and
+    #: the configuration in degrees. ``-1`` / ``()`` when there is no such place.
+    min_segment: int = -1
+    min_config_deg: tuple[float, ...] = ()
+    #: First path vertex outside the joint limits (``-1``: none).
+    limits_vertex: int = -1
+
+    def describe(self) -> str:
+        """One sentence on why the path is not certified (empty string when it is)."""
+        if self.certified:
+            return ""
+        if self.min_segment < 0 and self.limits_vertex < 0 and self.worst_segment < 0:
+            return "no path to certify"
+        q = ", ".join(f"{v:.6g}" for v in self.min_config_deg)
+        if self.penetration_m > 0.0:
+            return (f"segment {self.worst_segment} penetrates an obstacle "
+                    f"{self.penetration_m * 1e3:.4g} mm deep at q = ({q}) deg")
+        if self.limits_vertex >= 0:
+            return f"vertex {self.limits_vertex} is outside the joint limits"
+        return (f"segment {self.worst_segment} does not pass the certified check (smallest "
+                f"clearance {self.min_clearance_m * 1e6:.4g} um at q = ({q}) deg)")
 
 
 @nb.njit(cache=True, nogil=True)
@@ -145,42 +179,106 @@ def motion_bound(links, qa_deg, qb_deg):
 
 
 @nb.njit(cache=True, nogil=True)
-def segment_penetration(links, base, radius, obstacles, qa, qb, step_m):
-    """Deepest penetration found on ``qa -> qb``, no arm point moving > ``step_m`` per sample.
+def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals):
+    """Exact smallest signed clearance along ``path`` by Lipschitz branch and bound.
 
-    Where the signed clearance ``c`` is larger than ``step_m`` the scan jumps ahead by
-    ``c / M`` (no point can reach an obstacle sooner, the argument of the certified check), so
-    a free segment costs a few dozen distance evaluations instead of thousands; elsewhere it
-    advances by ``step_m / M``.
+    Returns ``(value, segment, s, lower bound)``: ``value`` is attained at ``path[segment] +
+    s (path[segment + 1] - path[segment])`` and no configuration on the path has a signed
+    clearance below ``lower bound`` (``>= value - tol`` unless ``max_evals`` was reached).
     """
-    m = motion_bound(links, qa, qb)
-    q = np.empty(qa.shape[0], dtype=np.float64)
-    q[:] = qa
-    worst = 0.0
-    s = 0.0
-    while True:
-        c = signed_clearance_kernel(links, base, radius, obstacles, q)
-        if -c > worst:
-            worst = -c
-        if s >= 1.0 or m <= 0.0:
-            return worst
-        s += max(c, step_m) / m
-        if s >= 1.0:
-            s = 1.0
-            q[:] = qb
-        else:
-            for d in range(qa.shape[0]):
-                q[d] = qa[d] + s * (qb[d] - qa[d])
+    n = path.shape[0]
+    if obstacles.shape[0] == 0 or n == 0:
+        return np.inf, -1, 0.0, np.inf
+    best = np.inf
+    best_seg = 0
+    best_s = 0.0
+    cv = np.empty(n, dtype=np.float64)
+    for i in range(n):
+        cv[i] = signed_clearance_kernel(links, base, radius, obstacles, path[i])
+        if cv[i] < best:
+            best = cv[i]
+            if i < n - 1 or n == 1:
+                best_seg = i
+                best_s = 0.0
+            else:
+                best_seg = n - 2
+                best_s = 1.0
+    floor = np.inf  # lower bound over intervals dropped unrefined (budget or resolution)
+    evals = n
+    depth_max = 200
+    s0s = np.empty(depth_max, dtype=np.float64)
+    s1s = np.empty(depth_max, dtype=np.float64)
+    c0s = np.empty(depth_max, dtype=np.float64)
+    c1s = np.empty(depth_max, dtype=np.float64)
+    q = np.empty(path.shape[1], dtype=np.float64)
+    for i in range(n - 1):
+        qa = path[i]
+        qb = path[i + 1]
+        m = motion_bound(links, qa, qb)
+        if m <= 0.0:
+            continue
+        top = 0
+        s0s[0] = 0.0
+        s1s[0] = 1.0
+        c0s[0] = cv[i]
+        c1s[0] = cv[i + 1]
+        top = 1
+        while top > 0:
+            top -= 1
+            s0 = s0s[top]
+            s1 = s1s[top]
+            c0 = c0s[top]
+            c1 = c1s[top]
+            lb = 0.5 * (c0 + c1 - m * (s1 - s0))
+            if lb >= best - tol:
+                continue
+            sm = 0.5 * (s0 + s1)
+            if evals >= max_evals or top + 2 > depth_max or not (s0 < sm < s1):
+                if lb < floor:
+                    floor = lb
+                continue
+            for d in range(q.shape[0]):
+                q[d] = qa[d] + sm * (qb[d] - qa[d])
+            cm = signed_clearance_kernel(links, base, radius, obstacles, q)
+            evals += 1
+            if cm < best:
+                best = cm
+                best_seg = i
+                best_s = sm
+            # Explore the half with the smaller end value first (pushed last).
+            if c0 <= c1:
+                s0s[top] = sm
+                s1s[top] = s1
+                c0s[top] = cm
+                c1s[top] = c1
+                s0s[top + 1] = s0
+                s1s[top + 1] = sm
+                c0s[top + 1] = c0
+                c1s[top + 1] = cm
+            else:
+                s0s[top] = s0
+                s1s[top] = sm
+                c0s[top] = c0
+                c1s[top] = cm
+                s0s[top + 1] = sm
+                s1s[top + 1] = s1
+                c0s[top + 1] = cm
+                c1s[top + 1] = c1
+            top += 2
+    lower = min(best - tol, floor)
+    return best, best_seg, best_s, lower
 
 
 @nb.njit(cache=True, nogil=True)
-def certify_kernel(links, base, radius, obstacles, limits, path, margin, step_m):
-    """``(certified, worst penetration, its segment, first uncertified segment)``."""
+def certify_kernel(links, base, radius, obstacles, limits, path, margin):
+    """``(certified, first uncertified segment, first vertex outside the limits)``."""
     n = path.shape[0]
     certified = True
     first_bad = -1
-    worst = 0.0
-    worst_seg = -1
+    first_out = -1
+    for i in range(n):
+        if first_out < 0 and not within_limits(limits, path[i]):
+            first_out = i
     for i in range(n - 1):
         qa = path[i]
         qb = path[i + 1]
@@ -189,19 +287,14 @@ def certify_kernel(links, base, radius, obstacles, limits, path, margin, step_m)
             ok = edge_free(links, base, radius, obstacles, qa, qb, margin)
         if not ok:
             certified = False
-            if first_bad < 0:
-                first_bad = i
-        if obstacles.shape[0] > 0:
-            p = segment_penetration(links, base, radius, obstacles, qa, qb, step_m)
-            if p > worst:
-                worst = p
-                worst_seg = i
-    return certified, worst, worst_seg, first_bad
+            first_bad = i
+            break
+    return certified, first_bad, first_out
 
 
-def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M,
-                 scan_step_m: float = SCAN_STEP_M) -> PathCheck:
-    """Certify ``path_deg`` (``[n, dof]`` degrees) in ``arrays`` (a ``ScenarioArrays``).
+def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
+    """Certify ``path_deg`` (``[n, dof]`` degrees) in ``arrays`` (a ``ScenarioArrays``) and
+    measure its exact minimum clearance.
 
     An empty path is not certified (there is nothing to vouch for). A single configuration is
     certified when it is within the limits and keeps clearance above ``margin``.
@@ -214,21 +307,33 @@ def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M,
         raise InputError("path", f"must be an array of shape [n, {dof}], got {path.shape}")
     if not np.all(np.isfinite(path)):
         raise InputError("path", "contains non-finite angles")
-    if not (scan_step_m > 0.0 and math.isfinite(scan_step_m)):
-        raise InputError("scan_step_m", f"must be a positive number, got {scan_step_m!r}")
+    value, seg, s, lower = min_clearance_kernel(
+        arrays.links, arrays.base, arrays.link_radius, arrays.obstacles, path,
+        MIN_CLEARANCE_TOL_M, MIN_CLEARANCE_MAX_EVALS)
+    value = float(value)
+    if float(lower) < value - MIN_CLEARANCE_TOL_M:
+        value = float(lower)  # budget reached: report the proven bound, never an optimistic one
+    where: tuple[float, ...] = ()
+    if seg >= 0:
+        qa = path[seg]
+        qb = path[min(seg + 1, path.shape[0] - 1)]
+        where = tuple(float(v) for v in qa + s * (qb - qa))
+    penetration = max(0.0, -value) if math.isfinite(value) else 0.0
     if path.shape[0] == 1:
         q = path[0]
-        c = float(signed_clearance_kernel(arrays.links, arrays.base, arrays.link_radius,
-                                          arrays.obstacles, q))
-        ok = bool(within_limits(arrays.limits_deg, q)) and c > margin
-        return PathCheck(certified=ok, penetration_m=max(0.0, -c), worst_segment=-1)
-    certified, worst, worst_seg, first_bad = certify_kernel(
+        inside = bool(within_limits(arrays.limits_deg, q))
+        ok = inside and value > margin
+        return PathCheck(certified=ok, penetration_m=penetration,
+                         worst_segment=0 if not ok and inside else -1,
+                         min_clearance_m=value, min_segment=seg, min_config_deg=where,
+                         limits_vertex=-1 if inside else 0)
+    certified, first_bad, first_out = certify_kernel(
         arrays.links, arrays.base, arrays.link_radius, arrays.obstacles, arrays.limits_deg,
-        path, float(margin), float(scan_step_m))
-    if worst <= 0.0:
-        worst_seg = first_bad
-    return PathCheck(certified=bool(certified), penetration_m=float(worst),
-                     worst_segment=int(worst_seg))
+        path, float(margin))
+    worst = int(seg) if penetration > 0.0 else (-1 if certified else int(first_bad))
+    return PathCheck(certified=bool(certified), penetration_m=float(penetration),
+                     worst_segment=worst, min_clearance_m=value, min_segment=int(seg),
+                     min_config_deg=where, limits_vertex=int(first_out))
 
 
 def signed_clearance(arrays, q_deg) -> float:

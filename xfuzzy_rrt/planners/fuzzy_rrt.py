@@ -239,8 +239,10 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     wall = time.perf_counter() - t0
     n = int(tree.meta[0])
     path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, 2))
-    result = PlanResult(
-        scenario=scenario.name, planner="fuzzy-rrt", seed=int(seed), success=bool(ok),
+    from xfuzzy_rrt.planners.result import certified_result  # certifies the path (found -> success)
+
+    result = certified_result(
+        a, margin, bool(ok), scenario=scenario.name, planner="fuzzy-rrt", seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),

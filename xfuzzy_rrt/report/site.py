@@ -84,9 +84,9 @@ def rulebooks_of(result) -> dict[str, Any]:
 def rulebook_dir(planner: str, result) -> str | None:
     """Where the rulebook of ``planner`` was read from (for reproduce commands)."""
     settings = dict(result.settings or {})
-    dirs = settings.get("rulebook_dirs")
-    if isinstance(dirs, dict) and dirs.get(planner):
-        return str(dirs[planner])
+    for entry in settings.get("rulebooks") or []:
+        if isinstance(entry, dict) and entry.get("planner") == planner and entry.get("dir"):
+            return str(entry["dir"])
     if planner == "fuzzy-rrt":
         return settings.get("rulebook_dir")
     if planner.startswith("fuzzy-rrt:"):

@@ -55,10 +55,13 @@ details > summary { cursor: pointer; color: #0550ae; }
 .xf-nav { font-size: 0.9em; padding: 4px 0; border-bottom: 1px solid #eee; }
 h1.xf-title { font-size: 1.35em; margin: 6px 0 0 0; }
 p.xf-sub { margin: 2px 0 6px 0; font-size: 0.9em; }
-ul.xf-verdict { margin: 6px 0; padding: 8px 12px 8px 28px; background: #f4f8fc;
-                border-left: 4px solid #0072B2; font-size: 1.02em; }
-ul.xf-verdict li { margin: 2px 0; }
+ul.xf-verdict { margin: 6px 0; padding: 6px 12px 6px 28px; background: #f4f8fc;
+                border-left: 4px solid #0072B2; line-height: 1.35; }
+ul.xf-verdict li { margin: 1px 0; }
 .xf-lose { color: #b2182b; font-weight: 600; }
+table.xf-planners { margin: 4px 0; }
+table.xf-planners th, table.xf-planners td { padding: 2px 7px; }
+table.xf-planners td:first-child { white-space: nowrap; font-weight: 600; }
 @media print { .xf-nav { display: none; } details { display: block; } }
 """
 

@@ -254,12 +254,13 @@ def _planner_table(t: pd.DataFrame) -> str:
             "\u2014" if base else N.ratio(r.ratio_worst),
             "\u2014" if base else f"{r.losses} of {r.compared}",
             N.seconds(r.time_first_median_s), N.qty(r.cost_median_deg, "deg"),
-            N.metres(r.min_clearance_m),
+            (f"penetrates {N.metres(-r.min_clearance_m)}" if r.min_clearance_m < 0
+             else N.metres(r.min_clearance_m)),
             f"{r.penetrating_paths} of {r.paths}" + (
                 f" (deepest {N.metres(r.penetration_max_m)})" if r.penetrating_paths else ""),
         ])
-    return ('<div class="scroll">' + table(rows, header, [str] * len(header))
-            + "</div>")
+    return ('<div class="scroll">' + table(rows, header, [str] * len(header),
+                                           css_class="data xf-planners") + "</div>")
 
 
 def _ratio_plot(ctx, runs: pd.DataFrame) -> str:

@@ -62,7 +62,11 @@ ul.xf-verdict li { margin: 1px 0; }
 table.xf-planners { margin: 4px 0; }
 table.xf-planners th, table.xf-planners td { padding: 2px 7px; }
 table.xf-planners td:first-child { white-space: nowrap; font-weight: 600; }
-@media print { .xf-nav { display: none; } details { display: block; } }
+@page { size: A4 landscape; margin: 10mm; }
+@media print { .xf-nav { display: none; } body { padding: 0; max-width: none; }
+               .scroll { overflow: visible; } table.data { font-size: 0.8em; }
+               h2 { break-after: avoid; } .cell, svg, .fig { break-inside: avoid; }
+               .modebar-container { display: none !important; } }
 """
 
 #: Sets plotly's global config before plotly.js loads (as plotly's own full-page output does):

@@ -18,6 +18,8 @@ from xfuzzy_rrt.errors import InputError
 
 CANDIDATES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 TIMEOUT_S = 180
+#: A4 landscape (297 mm) less two 10 mm margins, in CSS pixels (96 per inch).
+PRINT_WIDTH_PX = 1046
 
 
 def find_chromium() -> str:
@@ -45,6 +47,9 @@ def print_pdf(html: Path, pdf: Path, browser: str | None = None) -> None:
         cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu",
                "--disable-background-networking", "--disable-component-update", "--no-first-run",
                "--disable-sync", "--no-pdf-header-footer", "--virtual-time-budget=20000",
+               # Lay the page out at the printed width (A4 landscape less 10 mm margins), so
+               # that plotly sizes its figures for the paper, not for a screen.
+               f"--window-size={PRINT_WIDTH_PX},1400",
                "--run-all-compositor-stages-before-draw", f"--print-to-pdf={tmp}",
                Path(html).resolve().as_uri()]
         try:

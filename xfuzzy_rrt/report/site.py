@@ -299,17 +299,17 @@ def worst_pose(scenario, path_deg: np.ndarray) -> tuple[np.ndarray, float]:
     return dense[k], float(c[k])
 
 
-def worst_path_figure(scenario, run, clearance_m: float | None):
-    """The workspace figure of ``run`` with the arm drawn where it comes closest."""
+def worst_path_figure(scenario, run):
+    """The workspace figure of ``run`` with the arm drawn (red) where it comes closest."""
     q, c = worst_pose(scenario, run.path_deg)
+    closest = ("penetration " + N.metres(-c)) if c < 0 else N.metres(c)
     fig = F.workspace_figure(scenario, run, n_poses=3, title=(
-        f"{F.plot_text(F.planner_label(run.planner))} on {F.plot_text(scenario.name)} "
-        f"(seed {int(run.seed)})<br><sup>closest approach "
-        + ("penetration " + N.metres(-c) if c < 0 else N.metres(c))
-        + "; red: the arm there</sup>"))
+        f"<b>{F.plot_text(F.planner_label(run.planner))}</b><br><sup>"
+        f"{F.plot_text(scenario.name)}, seed {int(run.seed)}<br>closest approach {closest}"
+        "</sup>"))
     fig.add_trace(F._arm_trace(scenario, q, "closest configuration", "#d7191c", 5, True,
                                "closest"))
-    fig.update_layout(height=420, margin=dict(l=50, r=10, t=70, b=40))
+    fig.update_layout(height=400, showlegend=False, margin=dict(l=50, r=10, t=80, b=40))
     return fig
 
 
@@ -319,9 +319,10 @@ def _certification(ctx, page: Page, t: pd.DataFrame) -> None:
         "Every returned path is re-checked with this project's certified edge check (every "
         "configuration along every segment). A found path that fails it does not count as a "
         "success. Drawn: for each planner, the found run whose path came closest to an "
-        "obstacle (or went deepest into one) over all scenarios and seeds, with the arm at its "
-        "closest configuration. OMPL checks motions by sampling, so its paths may graze "
-        "obstacles between samples.")
+        "obstacle (or went deepest into one) over all scenarios and seeds -- grey: obstacles; "
+        "green and pink: the arm at start and goal; pale: the arm along the path; line: the "
+        "end-effector trace; red: the arm at its closest configuration. OMPL checks motions by "
+        "sampling, so its paths may graze obstacles between samples.")
     worst = dict(getattr(result, "worst", None) or {})
     cells = []
     for p in ctx["planners"]:
@@ -332,16 +333,15 @@ def _certification(ctx, page: Page, t: pd.DataFrame) -> None:
                          "stored worst path (a bench folder written before they were stored "
                          "or no path found)</p></div>")
             continue
-        fig = worst_path_figure(s, r, None)
+        fig = worst_path_figure(s, r)
         link = Names.from_entry(ctx["names"].scen[r.scenario]) \
             if r.scenario in ctx["names"].scen else None
         more = (f'<p class="muted"><a href="{esc(link)}">scenario {esc(r.scenario)}</a> '
                 f'\u00b7 reproduce: <code>{esc(_plan_cmd(ctx, s, p, r.seed))}</code></p>'
                 if link else "")
         cells.append(f'<div class="cell">{page.figure(fig, f"fig-worst-{slug(p)}")}{more}</div>')
-    ncol = max(1, min(4, len(cells)))
-    page.add(f'<div class="grid" style="grid-template-columns: repeat({ncol}, minmax(0, 1fr));">'
-             + "".join(cells) + "</div>")
+    page.add('<div class="grid" style="grid-template-columns: repeat(auto-fill, '
+             'minmax(300px, 1fr));">' + "".join(cells) + "</div>")
 
 
 def _rulebook_list(ctx, page: Page) -> None:

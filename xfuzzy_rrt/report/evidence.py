@@ -126,13 +126,13 @@ def _influence_table(run, rulebook, k: int = 3) -> str:
     """The rules that drove the example Fuzzy-RRT run: top ``k`` per output by influence."""
     from xfuzzy_rrt.analysis.firing import top_rules
     from xfuzzy_rrt.fuzzy.text_format import rule_sentence
-    from xfuzzy_rrt.fuzzy.variables import OUTPUTS
+    from xfuzzy_rrt.report.fuzzy_figures import semantics
     from xfuzzy_rrt.report.numbers import readable_numbers
 
     top = top_rules(run.trace, k=k)
     rows = []
     for _, row in top.iterrows():
-        fis = rulebook.systems[OUTPUTS.index(row["output"])]
+        fis = rulebook.systems[list(semantics(rulebook)[1]).index(row["output"])]
         rows.append((row["output"], f"r{int(row['rule'])}",
                      readable_numbers(rule_sentence(fis, int(row["rule"]))),
                      f"{100 * row['share']:.1f}%", int(row["iterations_fired"])))

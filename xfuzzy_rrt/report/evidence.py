@@ -87,7 +87,7 @@ def _follow_one_plan(page: Page, idx: int, s, run, rulebook, grid, settings: dic
     from xfuzzy_rrt.report.fuzzy_figures import firing_heatmap, io_series
 
     trace = run.trace
-    page.heading(f"Follow one plan: Fuzzy-RRT on {s.name} (seed {int(run.seed)})", level=3,
+    page.heading(f"Rule firing, inputs and outputs, drill-down (seed {int(run.seed)})", level=3,
                  anchor=f"follow-{idx}")
     plan = _plan_cmd(s, "fuzzy-rrt", run.seed, settings)
     page.add(page.figure(firing_heatmap(trace, rulebook), f"fig-s{idx}-firing"))

@@ -254,8 +254,7 @@ def _planner_table(t: pd.DataFrame) -> str:
             "\u2014" if base else N.ratio(r.ratio_worst),
             "\u2014" if base else f"{r.losses} of {r.compared}",
             N.seconds(r.time_first_median_s), N.qty(r.cost_median_deg, "deg"),
-            (f"penetrates {N.metres(-r.min_clearance_m)}" if r.min_clearance_m < 0
-             else N.metres(r.min_clearance_m)),
+            _clearance(r.min_clearance_m),
             f"{r.penetrating_paths} of {r.paths}" + (
                 f" (deepest {N.metres(r.penetration_max_m)})" if r.penetrating_paths else ""),
         ])
@@ -501,7 +500,7 @@ def _scenario_page(ctx, idx: int, name: str) -> str:
                 continue
             fig = (F.joint_space_figure(s, r, grid=grid) if kind == "joint"
                    else F.workspace_figure(s, r))
-            fig.update_layout(height=460)
+            fig.update_layout(height=500, legend=dict(y=-0.2))
             extra = (_reproduce(_plan_cmd(ctx, s, p, r.seed)) if kind == "workspace" else "")
             cells.append(f'<div class="cell">{page.figure(fig, f"fig-{slug(p)}-{kind}")}'
                          f"{extra}</div>")
@@ -545,6 +544,13 @@ def _followable(run, rulebook) -> bool:
             and run.rulebook_sha256 == rulebook.sha256)
 
 
+def _clearance(c) -> str:
+    """A minimum clearance; a negative one is a penetration and says so."""
+    if c is not None and c < 0:
+        return f"penetrates {N.metres(-c)}"
+    return N.metres(c)
+
+
 def _scenario_table(runs: pd.DataFrame, planners: list[str]) -> str:
     ok, found = success_mask(runs), found_mask(runs)
     rows = []
@@ -563,7 +569,7 @@ def _scenario_table(runs: pd.DataFrame, planners: list[str]) -> str:
                      f"{N.sig(it.min())} / {N.sig(it.median())} / {N.sig(it.max())}",
                      N.seconds(tf.median() if len(tf) else None),
                      N.qty(cost.median() if len(cost) else None, "deg"),
-                     N.metres(clear.min() if len(clear) else None)])
+                     _clearance(clear.min() if len(clear) else None)])
     return table(rows, ["planner", "certified success", "iterations min / median / max",
                         "median time to first path", "median cost", "min clearance"],
                  [str] * 6)

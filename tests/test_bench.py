@@ -194,6 +194,7 @@ def ompl_bench(scenarios):
 def test_ompl_rows_are_certified_exactly_when_the_exact_oracle_finds_no_collision(ompl_bench,
                                                                                  scenarios):
     from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
+    from xfuzzy_rrt.geometry.path_check import MIN_CLEARANCE_TOL_M
     from xfuzzy_rrt.planners.api import plan_scenario
 
     oracle = Oracle(TWO_CIRCLES)
@@ -206,9 +207,9 @@ def test_ompl_rows_are_certified_exactly_when_the_exact_oracle_finds_no_collisio
         problems = oracle.path_problems(again.path_deg)
         dense = float(np.min(oracle.clearance(oracle.densify(again.path_deg, 0.02))))
         assert row.success == (row.found and row.certified)
-        # The minimum clearance is exact: nothing on the path is closer (1 nm), and a dense
+        # The minimum clearance is exact: nothing on the path is closer (0.1 um), and a dense
         # oracle scan finds it to within its 0.02 deg resolution.
-        assert dense >= row.min_clearance_m - 1e-9
+        assert dense >= row.min_clearance_m - MIN_CLEARANCE_TOL_M
         assert dense == pytest.approx(row.min_clearance_m, abs=2e-5)
         assert row.penetration_m == max(0.0, -row.min_clearance_m)
         if row.certified:

@@ -13,7 +13,7 @@ from exact_geometry import Oracle
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.collision import clearance
 from xfuzzy_rrt.geometry.path_check import (
-    PathCheck,
+    MIN_CLEARANCE_TOL_M,
     certify_path,
     signed_clearance,
     signed_segment_obstacle_dist,
@@ -42,7 +42,7 @@ def test_rrt_paths_are_certified_with_zero_penetration_and_the_oracle_agrees(pat
         assert oracle.clearance(np.array(check.min_config_deg))[0] == pytest.approx(
             check.min_clearance_m, abs=1e-12)
         assert float(np.min(oracle.clearance(oracle.densify(r.path_deg, 0.02)))) >= \
-            check.min_clearance_m - 1e-9
+            check.min_clearance_m - MIN_CLEARANCE_TOL_M
         assert r.min_clearance_m == check.min_clearance_m
 
 
@@ -180,13 +180,13 @@ def test_min_clearance_is_exact_between_samples_and_says_where(tmp_path):
     # The straight arm sweeps 0 -> 6 deg; its centre line crosses the circle's centre at
     # atan2(0.01, 0.25) = 2.2906 deg (s = 0.382, no dyadic point of the segment): the exact
     # signed clearance there is -(radius + link radius) = -7 mm. A scan at 0.1 mm of arm motion
-    # is only good to ~0.05 mm; the branch and bound is good to 1 nm.
+    # is only good to ~0.05 mm; the branch and bound proves its value to 0.1 um.
     file = tmp_path / "sweep.toml"
     file.write_text(CIRCLE_ON_THE_SWEEP)
     s = load_scenario(file)
     check = certify_path(s.arrays(), np.array([s.start_deg, s.goal_deg]))
     assert not check.certified and check.worst_segment == 0 and check.min_segment == 0
-    assert check.min_clearance_m == pytest.approx(-0.007, abs=2e-9)
+    assert check.min_clearance_m == pytest.approx(-0.007, abs=MIN_CLEARANCE_TOL_M)
     assert check.penetration_m == -check.min_clearance_m
     assert check.min_config_deg[0] == pytest.approx(np.degrees(np.arctan2(0.01, 0.25)), abs=1e-5)
     assert check.min_config_deg[1] == 0.0
@@ -196,7 +196,7 @@ def test_min_clearance_is_exact_between_samples_and_says_where(tmp_path):
 
 def test_min_clearance_of_a_free_path_is_the_oracle_minimum(tmp_path):
     # Same sweep, circle moved 2 cm off the arm's reach: free, and the minimum lies at the
-    # sweep's end (the closest approach); the oracle's dense minimum agrees to 1 nm.
+    # sweep's end (the closest approach); nothing the oracle samples comes closer.
     file = tmp_path / "far.toml"
     file.write_text(CIRCLE_ON_THE_SWEEP.replace("center = [0.25, 0.01]", "center = [0.25, 0.04]"))
     s = load_scenario(file)
@@ -205,7 +205,7 @@ def test_min_clearance_of_a_free_path_is_the_oracle_minimum(tmp_path):
     check = certify_path(s.arrays(), path)
     dense = float(np.min(oracle.clearance(oracle.densify(path, 0.001))))
     assert check.certified and check.penetration_m == 0.0
-    assert dense >= check.min_clearance_m - 1e-9
+    assert dense >= check.min_clearance_m - MIN_CLEARANCE_TOL_M
     assert check.min_clearance_m == pytest.approx(dense, abs=1e-7)
     assert oracle.clearance(np.array(check.min_config_deg))[0] == pytest.approx(
         check.min_clearance_m, abs=1e-12)

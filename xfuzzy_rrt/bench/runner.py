@@ -163,11 +163,26 @@ def _warm_up(scenario: Scenario, planners: list[str], rulebooks: dict[str, Any])
                       max_iter=5)
 
 
-def _worker_init(scenario: Scenario, planners: list[str], rulebooks: dict[str, Any]) -> None:
-    """Worker start-up: leave Ctrl-C to the parent (which cancels the pool and reports it once;
-    a worker's KeyboardInterrupt traceback is noise), then warm up."""
-    import signal
+def _die_with_parent(parent: int) -> None:
+    """Ask Linux to kill this worker when its parent dies (``kill -9`` included), so a killed
+    bench leaves no orphan holding its pipes; elsewhere a no-op."""
+    import ctypes
+    import sys
 
+    if not sys.platform.startswith("linux"):
+        return
+    with contextlib.suppress(OSError, AttributeError):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+    if os.getppid() != parent:  # the parent died before the request took effect
+        os._exit(1)
+
+
+def _worker_init(parent: int, scenario: Scenario, planners: list[str],
+                 rulebooks: dict[str, Any]) -> None:
+    """Worker start-up: die with the parent, leave Ctrl-C to it (it cancels the pool and
+    reports once; a worker's KeyboardInterrupt traceback is noise), then warm up."""
+    _die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(AttributeError, ValueError):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
@@ -231,7 +246,8 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
             if progress is not None:
                 progress(len(outputs), len(jobs))
     else:
-        outputs = _run_pool(jobs, workers, (scenarios[0], planners, rulebooks), progress)
+        outputs = _run_pool(jobs, workers, (os.getpid(), scenarios[0], planners, rulebooks),
+                            progress)
     columns = RUN_COLUMNS + (["cost_short_deg"] if shortcut else [])
     runs_df = pd.DataFrame([row for _, row in outputs], columns=columns)
     for col in ("success", "found", "certified"):

@@ -106,7 +106,8 @@ def test_a_second_bench_into_the_same_folder_replaces_it_as_a_set(run_cli, tmp_p
     assert [(e["scenario"], e["planner"]) for e in index] == [("two-circles", "rrt")]
     files = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file())
     assert files == ["bench.json", "examples/e000-tree.parquet", "examples/index.json",
-                     "ratios.csv", "report.html", "runs.csv", "summary.csv"]
+                     "examples/worst.json", "ratios.csv", "report.html", "report/plotly.min.js",
+                     "report/scenario-00-two-circles.html", "runs.csv", "summary.csv"]
     assert set(pd.read_csv(out / "runs.csv")["scenario"]) == {"two-circles"}
     assert [p.name for p in tmp_path.iterdir()] == ["bench"], "a staging folder was left"
 

@@ -408,17 +408,21 @@ def _read_worst(path: Path) -> dict[str, PlanResult]:
     if not path.is_file():
         return {}
     out = {}
-    for e in _read_json(path):
-        out[str(e["planner"])] = PlanResult(
-            scenario=str(e["scenario"]), planner=str(e["planner"]), seed=int(e["seed"]),
-            found=bool(e["found"]), certified=bool(e["certified"]),
-            min_clearance_m=e.get("min_clearance_m"), penetration_m=e.get("penetration_m"),
-            violation=e.get("violation"), iterations=int(e["iterations"]), nodes=int(e["nodes"]),
-            cost_deg=e["cost_deg"], wall_s=float(e["wall_s"]),
-            path_deg=np.asarray(e["path_deg"], dtype=np.float64).reshape(-1, 2),
-            tree_nodes_deg=np.empty((0, 2)), tree_parent=np.empty(0, dtype=np.int64),
-            rulebook=e.get("rulebook"), rulebook_sha256=e.get("rulebook_sha256"),
-            params=dict(e.get("params") or {}))
+    for k, e in enumerate(_read_json(path)):
+        try:
+            found = bool(e.get("found", e.get("success", False)))
+            out[str(e["planner"])] = PlanResult(
+                scenario=str(e["scenario"]), planner=str(e["planner"]), seed=int(e["seed"]),
+                found=found, certified=found and bool(e.get("certified", e.get("success"))),
+                min_clearance_m=e.get("min_clearance_m"), penetration_m=e.get("penetration_m"),
+                violation=e.get("violation"), iterations=int(e["iterations"]),
+                nodes=int(e["nodes"]), cost_deg=e["cost_deg"], wall_s=float(e["wall_s"]),
+                path_deg=np.asarray(e["path_deg"], dtype=np.float64).reshape(-1, 2),
+                tree_nodes_deg=np.empty((0, 2)), tree_parent=np.empty(0, dtype=np.int64),
+                rulebook=e.get("rulebook"), rulebook_sha256=e.get("rulebook_sha256"),
+                params=dict(e.get("params") or {}))
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise InputError(str(path), f"entry {k}: not a stored run ({exc})") from None
     return out
 
 

@@ -165,11 +165,14 @@ def build_pages(result, command: str | None = None, generated_at: str | None = N
     ctx = dict(result=result, command=command, generated_at=generated_at, prov=prov,
                settings=settings, planners=planners, scen_names=scen_names, books=books,
                names=names, folder=folder)
-    pages = {ENTRY: _overview(ctx)}
-    for i, n in enumerate(scen_names):
-        pages[f"{ASSETS}/{names.scen[n]}"] = _scenario_page(ctx, i, n)
-    for p, rb in books.items():
-        pages[f"{ASSETS}/{names.rb[p]}"] = _rulebook_page(ctx, p, rb)
+    from xfuzzy_rrt.report.plotjson import no_default_template
+
+    with no_default_template():
+        pages = {ENTRY: _overview(ctx)}
+        for i, n in enumerate(scen_names):
+            pages[f"{ASSETS}/{names.scen[n]}"] = _scenario_page(ctx, i, n)
+        for p, rb in books.items():
+            pages[f"{ASSETS}/{names.rb[p]}"] = _rulebook_page(ctx, p, rb)
     return pages
 
 

@@ -218,6 +218,9 @@ def test_ompl_rows_are_certified_exactly_when_the_exact_oracle_finds_no_collisio
         else:
             assert problems and row.min_clearance_m < 0.0 and not row.success
             assert np.isnan(row.cost_short_deg), "an uncertified path is never shortened"
+    worst = ompl_bench.worst_examples[("two-circles", "ompl:RRTConnect")]
+    assert worst.min_clearance_m == rows["min_clearance_m"].min() and not worst.certified
+    assert worst.violation.startswith(f"segment ") and "penetrates an obstacle" in worst.violation
     s = ompl_bench.summary.set_index("planner").loc["ompl:RRTConnect"]
     assert s["success_rate"] == rows["certified"].mean() < s["found_rate"] == 1.0
     assert s["certified_fraction"] == rows["certified"].mean()
@@ -279,6 +282,10 @@ def test_several_rulebooks_run_side_by_side_one_row_each(scenarios, tmp_path):
     assert {e["planner"]: e["dir"] for e in meta["rulebooks"]}[f"fuzzy-rrt:{mine}"] == str(mine)
     back = load_bench_dir(out)
     assert {k: v.sha256 for k, v in back.rulebooks.items()} == sha
+    assert set(back.worst_examples) == set(back.examples)
+    for key, r in result.worst_examples.items():
+        assert back.worst_examples[key].seed == r.seed
+        assert back.worst_examples[key].min_clearance_m == r.min_clearance_m
     assert set(back.examples) == {("two-circles", p) for p in labels}
     assert all(back.examples[("two-circles", p)].trace is not None for p in sha)
 

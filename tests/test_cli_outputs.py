@@ -97,17 +97,20 @@ def test_a_second_bench_into_the_same_folder_replaces_it_as_a_set(run_cli, tmp_p
     first = run_cli("bench", TWO_CIRCLES, BOXES, "--planners", "rrt,fuzzy-rrt", "--runs", "2",
                     "--max-iter", "3000", "--out", out)
     assert first.returncode == 0, first.stderr
-    assert len(list((out / "examples").glob("*-tree.parquet"))) == 4
+    index = json.loads((out / "examples" / "index.json").read_text())
+    assert {e["scenario"] for e in index} == {"two-circles", "boxes-and-circle"}
     (out / "notes-from-an-old-run.txt").write_text("stale")
     second = run_cli("bench", TWO_CIRCLES, "--planners", "rrt", "--runs", "2", "--max-iter",
                      "3000", "--out", out)
     assert second.returncode == 0, second.stderr
     index = json.loads((out / "examples" / "index.json").read_text())
-    assert [(e["scenario"], e["planner"]) for e in index] == [("two-circles", "rrt")]
+    assert {(e["scenario"], e["planner"], e["role"]) for e in index} == {
+        ("two-circles", "rrt", "median"), ("two-circles", "rrt", "worst")}
     files = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file())
-    assert files == ["bench.json", "examples/e000-tree.parquet", "examples/index.json",
-                     "examples/worst.json", "ratios.csv", "report.html", "report/plotly.min.js",
-                     "report/scenario-00-two-circles.html", "runs.csv", "summary.csv"]
+    examples = sorted({f"examples/{e['tree']}" for e in index})
+    assert files == ["bench.json", *examples, "examples/index.json", "ratios.csv",
+                     "report.html", "report/plotly.min.js", "report/scenario-00-two-circles.html",
+                     "runs.csv", "summary.csv"]
     assert set(pd.read_csv(out / "runs.csv")["scenario"]) == {"two-circles"}
     assert [p.name for p in tmp_path.iterdir()] == ["bench"], "a staging folder was left"
 

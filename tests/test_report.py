@@ -270,35 +270,39 @@ def test_people_read_numbers_with_at_most_four_significant_digits(full):
 # ------------------------------------------------------------------ certification evidence
 
 
-def test_worst_clearance_run_is_chosen_per_planner():
-    from xfuzzy_rrt.bench.runner import worst_run_keys
+def test_worst_path_of_a_planner_is_its_closest_approach_over_all_scenarios():
+    from types import SimpleNamespace
 
-    runs = pd.DataFrame({
-        "scenario": ["a", "a", "b", "b", "a"], "planner": ["rrt", "rrt", "rrt", "x", "x"],
-        "seed": [0, 1, 0, 0, 1], "success": [True, True, True, False, True],
-        "found": [True, True, True, True, False],
-        "min_clearance_m": [0.02, 0.005, 0.01, -0.003, -0.5],
-        "penetration_m": [0.0, 0.0, 0.0, 0.003, np.nan]})
-    # The uncertified path of x (found, not a success) is its worst; the unfound run is not.
-    assert worst_run_keys(runs) == {"rrt": ("a", 1), "x": ("b", 0)}
-    old = runs.drop(columns=["found", "min_clearance_m"])
-    assert worst_run_keys(old)["rrt"] == ("a", 0)  # no clearances: the deepest penetration
+    from xfuzzy_rrt.report.site import worst_per_planner
+
+    def run(scen, clearance):
+        return SimpleNamespace(scenario=scen, min_clearance_m=clearance)
+
+    result = SimpleNamespace(scenarios={"a": None, "b": None, "c": None}, worst_examples={
+        ("a", "rrt"): run("a", 0.02), ("b", "rrt"): run("b", 0.005), ("c", "rrt"): run("c", 0.005),
+        ("a", "ompl:RRT"): run("a", -0.003), ("b", "ompl:RRT"): run("b", None)})
+    worst = worst_per_planner(result)
+    assert worst["rrt"].scenario == "b"  # the smallest clearance; the first scenario on ties
+    assert worst["ompl:RRT"].scenario == "a"  # a penetration is worse than any clearance
 
 
 def test_worst_path_of_each_planner_is_stored_and_drawn(full):
     result, out = full
-    stored = json.loads((out / "examples" / "worst.json").read_text())
-    assert sorted(e["planner"] for e in stored) == ["fuzzy-rrt", "rrt"]
+    index = json.loads((out / "examples" / "index.json").read_text())
+    stored = [e for e in index if e.get("role") == "worst"]
+    runs = result.runs
     html = (out / "report.html").read_text(encoding="utf-8")
     figs = _figures(html)
-    for e in stored:
-        r = result.runs
-        row = r[(r["planner"] == e["planner"]) & (r["scenario"] == e["scenario"])
-                & (r["seed"] == e["seed"])]
-        assert len(row) == 1 and bool(row["success"].iloc[0])
-        fig = figs[f"fig-worst-{e['planner']}"]
+    for planner in ("rrt", "fuzzy-rrt"):
+        mine = [e for e in stored if e["planner"] == planner]
+        assert len(mine) == 2  # one per scenario
+        closest = min(mine, key=lambda e: e["min_clearance_m"])
+        found = runs[(runs["planner"] == planner) & runs["found"].astype(bool)]
+        assert closest["min_clearance_m"] == pytest.approx(found["min_clearance_m"].min())
+        fig = figs[f"fig-worst-{planner}"]
         assert any(t.get("name") == "closest configuration" for t in fig["data"])
-        assert f"seed {e['seed']}" in json.dumps(fig["layout"]["title"])
+        title = json.dumps(fig["layout"]["title"])
+        assert f"{closest['scenario']}, seed {closest['seed']}" in title
 
 
 def test_worst_pose_is_the_closest_configuration_along_the_path(full):
@@ -307,7 +311,9 @@ def test_worst_pose_is_the_closest_configuration_along_the_path(full):
     from xfuzzy_rrt.report.site import worst_pose
 
     result, _ = full
-    r = result.worst["rrt"]
+    from xfuzzy_rrt.report.site import worst_per_planner
+
+    r = worst_per_planner(result)["rrt"]
     s = result.scenarios[r.scenario]
     q, c = worst_pose(s, r.path_deg)
     dense = F.interpolate_path(r.path_deg, 0.25)

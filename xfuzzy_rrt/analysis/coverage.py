@@ -36,7 +36,8 @@ import numpy as np
 import pandas as pd
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_OUTPUTS, N_RULES, OUTPUTS, rule_terms
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_OUTPUTS, N_RULES, rule_terms
 
 COVERAGE_COLUMNS = ["output", "rule", "antecedent", "constant", "fired", "strength_total",
                     "strength_mean", "mass_share", "rank", "cumulative_share", "carries_90",
@@ -70,7 +71,8 @@ class CoverageCounts:
 
 def counts_from_trace(trace: pd.DataFrame, success: bool | None = None) -> CoverageCounts:
     """Coverage counts of one run's trace (the DataFrame of :mod:`xfuzzy_rrt.planners.trace`)."""
-    needed = ["on_path"] + [f"{o}_rule_{k}" for o in OUTPUTS for k in range(MAX_FIRED)]
+    outputs = _sem.of_columns(trace.columns).outputs
+    needed = ["on_path"] + [f"{o}_rule_{k}" for o in outputs for k in range(MAX_FIRED)]
     missing = [c for c in needed if c not in trace.columns]
     if missing:
         raise InputError("trace", f"not a Fuzzy-RRT trace (missing column {missing[0]!r})")
@@ -80,7 +82,7 @@ def counts_from_trace(trace: pd.DataFrame, success: bool | None = None) -> Cover
         success = bool(n and "outcome" in trace and str(trace["outcome"].iloc[-1]) == "goal_reached")
     c.successes = int(success)
     on = trace["on_path"].to_numpy(dtype=bool)
-    for f, out in enumerate(OUTPUTS):
+    for f, out in enumerate(outputs):
         rules = trace[[f"{out}_rule_{k}" for k in range(MAX_FIRED)]].to_numpy(dtype=np.int64)
         w = trace[[f"{out}_strength_{k}" for k in range(MAX_FIRED)]].to_numpy(dtype=np.float64)
         mask = rules >= 0
@@ -151,7 +153,7 @@ def coverage_frame(counts: CoverageCounts, rulebook) -> pd.DataFrame:
     """One row per FIS and rule (6 x 625 rows, dead rules included); columns COVERAGE_COLUMNS."""
     parts = []
     n = max(counts.iterations, 1)
-    for f, out in enumerate(OUTPUTS):
+    for f, out in enumerate(rulebook.outputs):
         share = counts.strength[f] / n
         order = np.lexsort((np.arange(N_RULES), -share))
         rank = np.empty(N_RULES, dtype=np.int64)

@@ -24,12 +24,13 @@ import numpy as np
 import pandas as pd
 
 from xfuzzy_rrt.fuzzy.manifest import thaw
-from xfuzzy_rrt.fuzzy.variables import INPUTS, MAX_FIRED, N_RULES, OUTPUTS, rule_terms
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_RULES, rule_terms
 
 CELL_COLUMNS = ["output", "rule", "antecedent", "a", "b", "delta"]
 PEAK_COLUMNS = ["output", "input", "term", "a", "b", "shift"]
 META_COLUMNS = ["field", "a", "b"]
-DECISION_COLUMNS = [*OUTPUTS, "goal_sampled", "sample_q1_deg", "sample_q2_deg", "outcome",
+#: What a decision is beside the six outputs (whose names come from the rulebooks' semantics).
+DECISION_COLUMNS = ["goal_sampled", "sample_q1_deg", "sample_q2_deg", "outcome",
                     "new_node"]
 CAUSE_COLUMNS = ["output", "rule", "antecedent", "strength_a", "strength_b", "constant_a",
                  "constant_b", "contribution_change"]
@@ -54,7 +55,7 @@ class RulebookDiff:
     def per_output(self) -> pd.DataFrame:
         """Changed cells per FIS with the largest absolute change."""
         rows = []
-        for out in OUTPUTS:
+        for out in dict.fromkeys(self.cells["output"].tolist() + self.peaks["output"].tolist()):
             g = self.cells[self.cells["output"] == out]
             rows.append({"output": out, "cells_changed": len(g),
                          "max_abs_delta": float(g["delta"].abs().max()) if len(g) else 0.0,
@@ -203,14 +204,16 @@ def _explain_row(ta, tb, it, a, b) -> tuple[pd.DataFrame, pd.DataFrame]:
         return pd.DataFrame([("iterations", len(ta), len(tb))], columns=["quantity", "a", "b"]), causes
     row = it - 1
     drows = []
-    for c in [*INPUTS, *DECISION_COLUMNS]:
+    for c in [*a.inputs, *a.outputs, *DECISION_COLUMNS]:
+        if c not in ta or c not in tb:
+            continue
         va, vb = ta[c].iloc[row], tb[c].iloc[row]
         if c == "outcome":
             va, vb = str(va), str(vb)
-        if c in INPUTS or va != vb:
+        if c in a.inputs or va != vb:
             drows.append((c, va, vb))
     crows = []
-    for f, out in enumerate(OUTPUTS):
+    for f, out in enumerate(a.outputs):
         fa, fb = _fired(ta, row, out), _fired(tb, row, out)
         ca, cb = a.systems[f].consts, b.systems[f].consts
         for r in sorted(set(fa) | set(fb)):

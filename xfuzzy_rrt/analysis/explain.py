@@ -24,7 +24,8 @@ import pandas as pd
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.membership import partition
 from xfuzzy_rrt.fuzzy.text_format import rule_sentence
-from xfuzzy_rrt.fuzzy.variables import INPUTS, MAX_FIRED, OUTPUTS, rule_terms
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, rule_terms
 
 
 @dataclass(frozen=True)
@@ -93,7 +94,9 @@ def load_trace(path: str | Path) -> pd.DataFrame:
         raise
     except Exception as exc:  # pandas/pyarrow raise many types for unreadable files
         raise InputError(str(path), f"cannot read trace: {exc}") from None
-    missing = [c for c in ("iteration", *INPUTS, *OUTPUTS, "rulebook_sha256") if c not in frame]
+    # the trace's columns say which semantics made it (input names are unique per semantics)
+    sem = next((s for s in _sem.SEMANTICS.values() if s.inputs[0] in frame), _sem.PAPER)
+    missing = [c for c in ("iteration", *sem.inputs, *sem.outputs, "rulebook_sha256") if c not in frame]
     if missing:
         raise InputError(str(path), f"not a Fuzzy-RRT trace: missing column(s) {', '.join(missing)}")
     return frame
@@ -113,10 +116,10 @@ def explain_row(row: pd.Series, rulebook) -> Explanation:
         raise InputError("--rulebook", f"rulebook {rulebook.name!r} (sha256 {rulebook.sha256[:12]}…) "
                          f"is not the one that made this trace (sha256 "
                          f"{str(row['rulebook_sha256'])[:12]}…)")
-    x = {name: float(row[name]) for name in INPUTS}
+    x = {name: float(row[name]) for name in rulebook.inputs}
     systems = []
     clamped: dict[str, float] = {}
-    for f, output in enumerate(OUTPUTS):
+    for f, output in enumerate(rulebook.outputs):
         fis = rulebook.systems[f]
         degrees = []
         active: dict[str, tuple[ActiveTerm, ...]] = {}
@@ -156,9 +159,12 @@ def explain_row(row: pd.Series, rulebook) -> Explanation:
 
 def render_text(e: Explanation) -> str:
     """A plain-text rendering (what ``xfuzzy-rrt explain`` prints)."""
-    lines = [f"Iteration {e.iteration} — rulebook {e.rulebook!r} (bounds: {e.bounds_mode})", "",
-             "Inputs (measured from the end effector of the current node; clamped to the ranges):"]
-    for name in INPUTS:
+    where = ("measured from the end effector of the current node" if e.bounds_mode
+             else "measured at the current node in joint space")
+    lines = [f"Iteration {e.iteration} — rulebook {e.rulebook!r} "
+             f"({'bounds: ' + e.bounds_mode if e.bounds_mode else 'goal-frame semantics'})", "",
+             f"Inputs ({where}; clamped to the ranges):"]
+    for name in e.inputs:
         raw, c = e.inputs[name], e.clamped_inputs[name]
         note = "" if raw == c else f" (measured {raw!r}, clamped)"
         lines.append(f"  {name:18s} = {c!r}{note}")

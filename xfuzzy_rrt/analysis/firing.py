@@ -13,7 +13,8 @@ import numpy as np
 import pandas as pd
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, OUTPUTS
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 
 INFLUENCE_COLUMNS = ["output", "rule", "iterations_fired", "influence", "share",
                      "mean_strength"]
@@ -24,8 +25,9 @@ def rule_influence(trace: pd.DataFrame, output: str) -> pd.DataFrame:
 
     Sorted by decreasing influence (ties: lower rule index first).
     """
-    if output not in OUTPUTS:
-        raise InputError("output", f"unknown output {output!r}; outputs are {', '.join(OUTPUTS)}")
+    outputs = _sem.of_columns(trace.columns).outputs
+    if output not in outputs:
+        raise InputError("output", f"unknown output {output!r}; outputs are {', '.join(outputs)}")
     n = len(trace)
     rules = trace[[f"{output}_rule_{k}" for k in range(MAX_FIRED)]].to_numpy().ravel()
     strengths = trace[[f"{output}_strength_{k}" for k in range(MAX_FIRED)]].to_numpy().ravel()
@@ -50,5 +52,5 @@ def rule_influence(trace: pd.DataFrame, output: str) -> pd.DataFrame:
 
 def top_rules(trace: pd.DataFrame, k: int = 5) -> pd.DataFrame:
     """The ``k`` most influential rules of every output, one table."""
-    parts = [rule_influence(trace, out).head(k) for out in OUTPUTS]
+    parts = [rule_influence(trace, out).head(k) for out in _sem.of_columns(trace.columns).outputs]
     return pd.concat(parts, ignore_index=True)

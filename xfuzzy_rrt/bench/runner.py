@@ -64,9 +64,9 @@ class BenchResult:
     provenance: dict[str, Any] = field(default_factory=dict)
     #: Planner label (``fuzzy-rrt``, ``fuzzy-rrt:paper``, ...) -> the loaded rulebook it ran.
     rulebooks: dict[str, Any] = field(default_factory=dict)
-    #: Per planner, the found run that came closest to an obstacle (or went deepest into one):
-    #: the certification evidence an auditor asks for (see :func:`worst_run_keys`).
-    worst: dict[str, PlanResult] = field(default_factory=dict)
+    #: For each (scenario, planner), the returned path that came closest to an obstacle (or went
+    #: deepest into one): what a safety audit looks at, next to the median run.
+    worst_examples: dict[tuple[str, str], PlanResult] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -197,24 +197,13 @@ def _median_run_seed(group: pd.DataFrame) -> int | None:
     return int(ok["seed"].iloc[int(np.argmin(np.abs(ok["iterations"].to_numpy() - target)))])
 
 
-def worst_run_keys(runs: pd.DataFrame) -> dict[str, tuple[str, int]]:
-    """Per planner, ``(scenario, seed)`` of the found run with the smallest ``min_clearance_m``
-    (the deepest ``penetration_m`` when clearances were not recorded); first in run order on
-    ties. Median runs never show the one path that grazed an obstacle; this one does."""
-    found = runs["found"] if "found" in runs.columns else runs["success"]
-    ok = runs[found.astype(bool)]
-    if "min_clearance_m" in ok.columns:
-        key = pd.to_numeric(ok["min_clearance_m"], errors="coerce")
-    elif "penetration_m" in ok.columns:
-        key = -pd.to_numeric(ok["penetration_m"], errors="coerce").fillna(0.0)
-    else:
-        return {}
-    out = {}
-    for planner, k in key.groupby(ok["planner"], sort=False):
-        if k.notna().any():
-            row = ok.loc[k.idxmin()]
-            out[str(planner)] = (str(row["scenario"]), int(row["seed"]))
-    return out
+def _worst_run_seed(group: pd.DataFrame) -> int | None:
+    """Seed of the found run with the smallest minimum clearance (the first on ties)."""
+    found = group[group["found"].astype(bool)]
+    if found.empty:
+        return None
+    clearance = pd.to_numeric(found["min_clearance_m"], errors="coerce").fillna(np.inf)
+    return int(found["seed"].iloc[int(np.argmin(clearance.to_numpy()))])
 
 
 def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50, seed: int = 0,
@@ -267,7 +256,13 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
             example = plan_scenario(by_name[scen], planner=planner, rulebook=rulebooks[planner],
                                     seed=seed_, max_iter=max_iter, trace=True)
         examples[(scen, planner)] = example
-    worst = {p: by_run[(scen, p, sd)] for p, (scen, sd) in worst_run_keys(runs_df).items()}
+    worst = {}
+    for (scen, planner), group in runs_df.groupby(["scenario", "planner"], sort=False):
+        seed_ = _worst_run_seed(group)
+        if seed_ is not None:
+            same = examples.get((scen, planner))
+            worst[(scen, planner)] = (same if same is not None and same.seed == seed_
+                                      else by_run[(scen, planner, seed_)])
     first = next(iter(rulebooks), None)
     main_label = "fuzzy-rrt" if "fuzzy-rrt" in rulebooks else first
     main_rb = rulebooks.get(main_label) if main_label else None
@@ -280,7 +275,7 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
                                "sha256": rb.sha256} for label, rb in rulebooks.items()]}
     return BenchResult(runs=runs_df, summary=summary, examples=examples, scenarios=by_name,
                        settings=settings, rulebook=main_rb, ratios=ratio_table(summary),
-                       rulebooks=dict(rulebooks), worst=worst)
+                       rulebooks=dict(rulebooks), worst_examples=worst)
 
 
 def _run_pool(jobs: list[_Job], workers: int, init_args: tuple, progress: Progress | None):

@@ -9,12 +9,11 @@ Layout (written into a hidden sibling folder, then swapped in as a whole -- see
     bench.json            settings, provenance (command, date, versions, git, machine), every
                           scenario file (path, SHA-256 and its TOML text) and the rulebook
                           (directory, SHA-256, training history)
-    examples/index.json   the example runs (median-iteration run per scenario and planner):
-                          bookkeeping and path
+    examples/index.json   the example runs per scenario and planner -- the median-iteration
+                          run (role "median") and the returned path closest to an obstacle
+                          (role "worst") -- bookkeeping and path
     examples/eNN-tree.parquet   their search trees
     examples/eNN-trace.parquet  Fuzzy-RRT traces (what the drill-down explains)
-    examples/worst.json   per planner, the found run closest to (or deepest into) an obstacle:
-                          bookkeeping and path (the report's certification panel)
 
 Why the scenario text is copied into ``bench.json``: it is a few hundred bytes and makes the
 folder self-contained (the files may move or change after the benchmark; the SHA-256 records
@@ -47,7 +46,6 @@ FORMAT = "xfuzzy-rrt-bench"
 FORMAT_VERSION = 1
 BENCH_JSON = "bench.json"
 EXAMPLES = "examples"
-WORST_JSON = "worst.json"
 
 
 def _json(obj: Any) -> str:
@@ -139,45 +137,45 @@ def _with_provenance(result: BenchResult, meta: dict[str, Any]) -> BenchResult:
 
 
 def _write_examples(result: BenchResult, folder: Path) -> None:
+    """The median run (``role: median``) and the closest-to-an-obstacle run (``role: worst``)
+    of each (scenario, planner); a worst run that is the median run shares its files."""
     folder.mkdir(parents=True, exist_ok=True)
+    order = list(result.scenarios)
+
+    def key(kv):
+        (scen, planner), _ = kv
+        return (order.index(scen) if scen in order else 1 << 30, planner)
+
     index = []
-    for k, ((scen, planner), r) in enumerate(sorted(
-            result.examples.items(), key=lambda kv: (list(result.scenarios).index(kv[0][0])
-                                                     if kv[0][0] in result.scenarios else 1 << 30,
-                                                     kv[0][1]))):
-        stem = f"e{k:03d}"
-        tree = pd.DataFrame({"q1_deg": np.asarray(r.tree_nodes_deg, dtype=np.float64)[:, 0],
-                             "q2_deg": np.asarray(r.tree_nodes_deg, dtype=np.float64)[:, 1],
-                             "parent": np.asarray(r.tree_parent, dtype=np.int64)})
-        with atomic_path(folder / f"{stem}-tree.parquet") as tmp:
-            tree.to_parquet(tmp, index=False)
-        trace_file = None
-        if isinstance(r.trace, pd.DataFrame):
-            trace_file = f"{stem}-trace.parquet"
-            with atomic_path(folder / trace_file) as tmp:
-                r.trace.to_parquet(tmp, index=False)
+    stems: dict[tuple[str, str, int], tuple[str, str | None]] = {}
+    entries = [("median", kv) for kv in sorted(result.examples.items(), key=key)]
+    entries += [("worst", kv) for kv in sorted((result.worst_examples or {}).items(), key=key)]
+    for role, ((scen, planner), r) in entries:
+        known = stems.get((scen, planner, int(r.seed)))
+        if known is None:
+            stem = f"e{len(stems):03d}"
+            tree = pd.DataFrame({"q1_deg": np.asarray(r.tree_nodes_deg, dtype=np.float64)[:, 0],
+                                 "q2_deg": np.asarray(r.tree_nodes_deg, dtype=np.float64)[:, 1],
+                                 "parent": np.asarray(r.tree_parent, dtype=np.int64)})
+            with atomic_path(folder / f"{stem}-tree.parquet") as tmp:
+                tree.to_parquet(tmp, index=False)
+            trace_file = None
+            if isinstance(r.trace, pd.DataFrame):
+                trace_file = f"{stem}-trace.parquet"
+                with atomic_path(folder / trace_file) as tmp:
+                    r.trace.to_parquet(tmp, index=False)
+            known = stems[(scen, planner, int(r.seed))] = (f"{stem}-tree.parquet", trace_file)
         index.append({
-            "scenario": scen, "planner": planner, "seed": int(r.seed), "success": bool(r.success),
-            "found": bool(r.found), "certified": bool(r.certified),
+            "role": role, "scenario": scen, "planner": planner, "seed": int(r.seed),
+            "success": bool(r.success), "found": bool(r.found), "certified": bool(r.certified),
             "min_clearance_m": r.min_clearance_m, "penetration_m": r.penetration_m,
-            "violation": r.violation, "iterations": int(r.iterations), "nodes": int(r.nodes), "cost_deg": r.cost_deg,
-            "wall_s": float(r.wall_s), "rulebook": r.rulebook,
+            "violation": r.violation, "iterations": int(r.iterations), "nodes": int(r.nodes),
+            "cost_deg": r.cost_deg, "wall_s": float(r.wall_s), "rulebook": r.rulebook,
             "rulebook_sha256": r.rulebook_sha256, "params": _plain(dict(r.params or {})),
             "path_deg": np.asarray(r.path_deg, dtype=np.float64).tolist(),
-            "tree": f"{stem}-tree.parquet", "trace": trace_file,
+            "tree": known[0], "trace": known[1],
         })
     write_text_atomic(folder / "index.json", _json(_plain(index)))
-    # The worst-clearance found run of each planner (the report's certification panel): the
-    # path only, no tree.
-    worst = [{"planner": p, "scenario": r.scenario, "seed": int(r.seed),
-              "found": bool(r.found), "certified": bool(r.certified),
-              "min_clearance_m": r.min_clearance_m, "penetration_m": r.penetration_m,
-              "violation": r.violation, "iterations": int(r.iterations), "nodes": int(r.nodes),
-              "cost_deg": r.cost_deg, "wall_s": float(r.wall_s), "rulebook": r.rulebook,
-              "rulebook_sha256": r.rulebook_sha256, "params": _plain(dict(r.params or {})),
-              "path_deg": np.asarray(r.path_deg, dtype=np.float64).tolist()}
-             for p, r in getattr(result, "worst", {}).items()]
-    write_text_atomic(folder / WORST_JSON, _json(_plain(worst)))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -351,6 +349,9 @@ def load_bench_dir(folder: Path, rulebook: Path | None = None,
     meta = _read_json(folder / BENCH_JSON)
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise InputError(str(folder / BENCH_JSON), f"format: expected {FORMAT!r}")
+    from xfuzzy_rrt.bench.provenance import check_bench_json
+
+    check_bench_json(meta, folder / BENCH_JSON)
     runs = read_runs(folder / "runs.csv")
     summary = _read_csv(folder / "summary.csv")
     summary["scenario"] = summary["scenario"].astype(str)
@@ -377,11 +378,10 @@ def load_bench_dir(folder: Path, rulebook: Path | None = None,
     if history is not None:
         if not Path(history).is_file():
             raise InputError(str(history), "no such file")
-    examples = _read_examples(folder / EXAMPLES)
+    examples, worst = _read_examples(folder / EXAMPLES)
     result = BenchResult(runs=runs, summary=summary, examples=examples, scenarios=scenarios,
                          settings=dict(meta.get("settings") or {}), rulebook=rb, ratios=ratios,
-                         rulebooks=rulebooks,
-                         worst=_read_worst(folder / EXAMPLES / WORST_JSON))
+                         rulebooks=rulebooks, worst_examples=worst)
     result = _with_provenance(result, meta)
     if history is not None:
         result.provenance["history"] = str(Path(history).resolve())
@@ -403,32 +403,12 @@ def _load_recorded_rulebook(entry: dict[str, Any], override, where: str):
     return rb
 
 
-def _read_worst(path: Path) -> dict[str, PlanResult]:
-    """The worst-clearance runs (absent in folders written before they were stored)."""
-    if not path.is_file():
-        return {}
-    out = {}
-    for k, e in enumerate(_read_json(path)):
-        try:
-            found = bool(e.get("found", e.get("success", False)))
-            out[str(e["planner"])] = PlanResult(
-                scenario=str(e["scenario"]), planner=str(e["planner"]), seed=int(e["seed"]),
-                found=found, certified=found and bool(e.get("certified", e.get("success"))),
-                min_clearance_m=e.get("min_clearance_m"), penetration_m=e.get("penetration_m"),
-                violation=e.get("violation"), iterations=int(e["iterations"]),
-                nodes=int(e["nodes"]), cost_deg=e["cost_deg"], wall_s=float(e["wall_s"]),
-                path_deg=np.asarray(e["path_deg"], dtype=np.float64).reshape(-1, 2),
-                tree_nodes_deg=np.empty((0, 2)), tree_parent=np.empty(0, dtype=np.int64),
-                rulebook=e.get("rulebook"), rulebook_sha256=e.get("rulebook_sha256"),
-                params=dict(e.get("params") or {}))
-        except (KeyError, TypeError, ValueError, AttributeError) as exc:
-            raise InputError(str(path), f"entry {k}: not a stored run ({exc})") from None
-    return out
-
-
-def _read_examples(folder: Path) -> dict[tuple[str, str], PlanResult]:
+def _read_examples(folder: Path) -> tuple[dict[tuple[str, str], PlanResult],
+                                          dict[tuple[str, str], PlanResult]]:
+    """``(median examples, worst examples)``; entries without a role are median runs."""
     index = _read_json(folder / "index.json")
-    out = {}
+    out: dict[tuple[str, str], PlanResult] = {}
+    worst: dict[tuple[str, str], PlanResult] = {}
     for e in index:
         try:
             tree = pd.read_parquet(folder / e["tree"])
@@ -439,7 +419,8 @@ def _read_examples(folder: Path) -> dict[tuple[str, str], PlanResult]:
         # Folders written before found/certified existed: their "success" meant "found", and
         # only certified examples were drawn.
         found = bool(e.get("found", e["success"]))
-        out[(str(e["scenario"]), str(e["planner"]))] = PlanResult(
+        target = worst if e.get("role") == "worst" else out
+        target[(str(e["scenario"]), str(e["planner"]))] = PlanResult(
             scenario=str(e["scenario"]), planner=str(e["planner"]), seed=int(e["seed"]),
             found=found, certified=found and bool(e.get("certified", e["success"])),
             min_clearance_m=e.get("min_clearance_m"), penetration_m=e.get("penetration_m"),
@@ -449,4 +430,4 @@ def _read_examples(folder: Path) -> dict[tuple[str, str], PlanResult]:
             tree_parent=tree["parent"].to_numpy(dtype=np.int64), rulebook=e.get("rulebook"),
             rulebook_sha256=e.get("rulebook_sha256"), params=dict(e.get("params") or {}),
             trace=trace)
-    return out
+    return out, worst

@@ -136,32 +136,35 @@ def demo(
     out: Path = typer.Option(Path("reports/demo"), "--out", help="Output folder."),
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),
     workers: int = typer.Option(2, "--workers", min=1, help="Worker processes."),
+    problems: int = typer.Option(24, "--problems", min=1, max=1000,
+                                 help="Generated problems to benchmark (generator seed 2000)."),
 ) -> int:
     """Benchmark RRT vs the trained Fuzzy-RRT and write the reports.
 
-    The default rulebook (``general``, trained on generated problems only) on 24 fresh
-    problems of the ``sample-*`` family that no training run saw (generator seed 2000; the
-    files are written to OUT/scenarios), into OUT; and, when the shared reference problem sits
-    beside the project, the ``paper`` rulebook (the paper's setting) on it, into
-    OUT/paper-reference.
+    Two benchmarks, everything shipped in the package: (1) RRT vs Fuzzy-RRT with the default
+    rulebook (``general``, trained on generated problems only) on PROBLEMS fresh problems of
+    the ``sample-*`` family that no training run saw (generator seed 2000; the files are written
+    to OUT/scenarios), into OUT; (2) RRT vs Fuzzy-RRT with the ``paper`` rulebook on the
+    paper's reference problem (the paper's setting), into OUT/paper-reference.
     """
     from xfuzzy_rrt.atomic import write_text_atomic
     from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+    from xfuzzy_rrt.resources import paper_reference_scenario
     from xfuzzy_rrt.scenarios.generate import generate_one
 
     files = []
-    for k in range(24):
+    for k in range(problems):
         problem = generate_one(2000, k)
         path = out / "scenarios" / f"{problem.scenario.name}.toml"
         write_text_atomic(path, problem.text)
         files.append(path)
     code = _run(files, "rrt,fuzzy-rrt", runs, 0, None, 10_000, out, workers,
                 keep=("scenarios", "paper-reference"))
-    reference = rulebooks_dir().parent.parent / "shared" / "scenarios" / "paper-reference.toml"
-    paper = rulebooks_dir() / "paper"
-    if reference.is_file() and paper.is_dir():
-        code = max(code, _run([reference], "rrt,fuzzy-rrt", runs, 0, paper, 10_000,
-                              out / "paper-reference", workers))
+    for stale in sorted((out / "scenarios").glob("*.toml")):
+        if stale not in files:  # from an earlier demo with more --problems
+            stale.unlink()
+    code = max(code, _run([paper_reference_scenario()], "rrt,fuzzy-rrt", runs, 0,
+                          rulebooks_dir() / "paper", 10_000, out / "paper-reference", workers))
     return code
 
 

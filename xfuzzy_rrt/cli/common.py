@@ -19,13 +19,10 @@ def warn(message: str) -> None:
 
 
 def load_scenario_warn(path: Path):
-    """Load a scenario; warn (stderr) about keys the format does not know (likely typos)."""
+    """Load a scenario (an unknown key is an error there, not a warning: see xfuzzy_rrt.strict)."""
     from xfuzzy_rrt.geometry.scenario import load_scenario
 
-    scenario = load_scenario(path)
-    for key in scenario.unknown_keys:
-        warn(f"{path}: {key}: unknown key ignored")
-    return scenario
+    return load_scenario(path)
 
 
 def format_json(obj: dict[str, Any]) -> str:

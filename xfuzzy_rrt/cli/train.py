@@ -44,6 +44,8 @@ class _Progress:
             f"gen {self.gen:>3}/{self.generations}  best {row['best_fitness']:9.1f}  "
             f"mean {row['mean_fitness']:9.1f}  median {row['median_fitness']:9.1f}  "
             f"best median iterations {row['best_median_iterations']:7.1f}  "
+            + (f"validation {row['validation_fitness']:.4g}  "
+               if row.get("validation_fitness") == row.get("validation_fitness") else "") +
             f"{row['runs_per_s']:8.0f} runs/s  {row['wall_s']:6.2f} s  ETA <= {eta:5.0f} s")
 
     def phase(self, text: str) -> None:
@@ -61,13 +63,15 @@ def train(
     population: int = typer.Option(400, "--population", help="Individuals per generation (paper: 400)."),
     generations: int = typer.Option(50, "--generations", help="Maximum generations (paper: 50)."),
     runs_per_eval: int = typer.Option(5, "--runs-per-eval", help="Planner runs per scenario per individual (paper: 5)."),
-    target_fitness: float = typer.Option(9750.0, "--target-fitness", help="Stop when the best fitness reaches this (paper: 9750)."),
+    target_fitness: Optional[float] = typer.Option(None, "--target-fitness", help="Stop when the best fitness reaches this (default: the paper's 9750 with --fitness paper; never with log-ratio)."),
     seed: int = typer.Option(0, "--seed", help="Seed: the result depends only on it and the inputs."),
     workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: all cores; 1 = in-process)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address (tcp://HOST:PORT): evaluate there."),
     out: Path = typer.Option(..., "--out", help="Rulebook directory to write (also history.csv and checkpoint/)."),
     resume: bool = typer.Option(False, "--resume", help="Continue from OUT/checkpoint after an interruption."),
-    bounds: str = typer.Option("absolute", "--bounds", help="How bound outputs are meant: absolute (paper) or relative."),
+    bounds: str = typer.Option("absolute", "--bounds", help="Planner semantics: absolute or relative bounds (the paper's semantics), or goal-frame."),
+    fitness: str = typer.Option("paper", "--fitness", help="paper (mean of 10000 - iterations, -100 on failure) or log-ratio (mean log of RRT's median / iterations per problem)."),
+    validation_scenario: List[Path] = typer.Option([], "--validation-scenario", help="Held-out scenario file or directory (repeatable): picks the final rulebook, gives the train/validation gap."),
     max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run (reward = max_iter - iterations)."),
     elite: int = typer.Option(8, "--elite", help="Best individuals copied unchanged into the next generation."),
     tournament: int = typer.Option(3, "--tournament", help="Tournament size of the selection."),
@@ -78,14 +82,36 @@ def train(
     block_rate: float = typer.Option(0.5, "--block-rate", help="Per-child probability of a term-block mutation."),
     block_sigma: float = typer.Option(0.05, "--block-sigma", help="Scale of term-block mutations (genes are in [0, 1])."),
     init: str = typer.Option("seeded", "--init", help="First generation: seeded (known rulebooks + perturbations) or random."),
+    seed_rulebook: Optional[List[Path]] = typer.Option(None, "--seed-rulebook", help="Rulebook directory the seeded first generation starts from (repeatable; default: the shipped expert when its bounds mode matches --bounds). Its SHA-256 is recorded."),
     validation_runs: int = typer.Option(50, "--validation-runs", help="Runs per scenario to choose the final rulebook."),
     name: Optional[str] = typer.Option(None, "--name", help="Rulebook name (default: the --out folder's name)."),
 ) -> int:
     """Train the six fuzzy systems with the paper's genetic algorithm; write a rulebook."""
+    import dataclasses
+
+    from xfuzzy_rrt.errors import InputError
     from xfuzzy_rrt.training.ga import GAConfig
-    from xfuzzy_rrt.training.run import TrainJob, load_training_scenarios, run_training
+    from xfuzzy_rrt.training.run import (
+        TrainJob,
+        load_training_scenarios,
+        resolve_seed_rulebooks,
+        run_training,
+    )
+
+    if workers is not None and workers < 1:
+        raise InputError("--workers", f"must be >= 1, got {workers}")
+    from xfuzzy_rrt.training.run import baselines
 
     scenarios = load_training_scenarios(scenario)
+    held_out = load_training_scenarios(validation_scenario) if validation_scenario else []
+    if target_fitness is None:
+        target_fitness = 9750.0 if fitness == "paper" else 1e9
+    base = v_base = ()
+    if fitness == "log-ratio":
+        typer.echo(f"computing RRT's median iterations on {len(scenarios) + len(held_out)} "
+                   "scenario(s) (the log-ratio baseline)", err=True)
+        base = baselines(scenarios, max_iter)
+        v_base = baselines(held_out, max_iter) if held_out else ()
     config = GAConfig(
         population=population, generations=generations, runs_per_eval=runs_per_eval,
         target_fitness=target_fitness, seed=seed, bounds=bounds, max_iter=max_iter, elite=elite,
@@ -93,9 +119,16 @@ def train(
         mutation_rate=mutation_rate, mutation_eta=mutation_eta, block_rate=block_rate,
         block_sigma=block_sigma, init=init, validation_runs=validation_runs,
         scenarios=tuple((t.scenario.name, t.sha256) for t in scenarios),
+        fitness=fitness, baseline=base,
+        validation=tuple((t.scenario.name, t.sha256) for t in held_out), validation_baseline=v_base,
     )
+    seeds = resolve_seed_rulebooks(seed_rulebook, config.init, config.bounds)
+    config = dataclasses.replace(config, seed_rulebooks=tuple((s.rulebook.name, s.sha256)
+                                                              for s in seeds))
     job = TrainJob(config=config, scenarios=scenarios, out=out, resume=resume, workers=workers,
-                   scheduler=scheduler, name=name, scenario_args=[str(p) for p in scenario])
+                   scheduler=scheduler, name=name, scenario_args=[str(p) for p in scenario],
+                   validation=held_out, validation_args=[str(p) for p in validation_scenario],
+                   seed_rulebooks=seeds)
     progress = _Progress(generations)
     try:
         result = run_training(job, on_start=progress.start, on_generation=progress.generation,

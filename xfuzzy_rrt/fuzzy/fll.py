@@ -40,16 +40,8 @@ from pathlib import Path
 from xfuzzy_rrt.errors import RulebookError
 from xfuzzy_rrt.fuzzy.rulebook import Rulebook, write_files
 from xfuzzy_rrt.fuzzy.system import FuzzySystem, InputPartition, peaks_problem, term_name_problem
-from xfuzzy_rrt.fuzzy.variables import (
-    INPUT_RANGES,
-    INPUTS,
-    N_RULES,
-    N_TERMS,
-    OUTPUT_RANGES,
-    OUTPUTS,
-    rule_index,
-    rule_terms,
-)
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.fuzzy.variables import N_RULES, N_TERMS, rule_index, rule_terms
 
 FLL_SUFFIX = ".fll"
 _DESCRIPTION_TAG = "xfuzzy-rrt"
@@ -75,6 +67,8 @@ def format_fll(fis: FuzzySystem, rulebook: Rulebook | None = None) -> str:
     lines.append(f"Engine: {fis.output}")
     if rulebook is not None:
         meta = {"name": rulebook.name, "bounds_mode": rulebook.bounds_mode, "sha256": rulebook.sha256}
+        if rulebook.semantics.name != "paper":
+            meta["semantics"] = rulebook.semantics.name
         lines.append(f"  description: {_DESCRIPTION_TAG} {json.dumps(meta, sort_keys=True)}")
     for inp in fis.inputs:
         lo, p1, p2, p3, hi = inp.peaks
@@ -154,8 +148,10 @@ def _peak_of(ttype: str, params: list[float]) -> tuple[float, float, float] | No
     return None
 
 
-def parse_fll(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem | None, dict, list[Problem]]:
+def parse_fll(data: bytes, file: str, expected_output: str,
+              sem: "_sem.Semantics" = None) -> tuple[FuzzySystem | None, dict, list[Problem]]:
     """Parse one exported-style FLL engine into a FIS. Returns (fis or None, meta, problems)."""
+    sem = sem or _sem.PAPER
     problems: list[Problem] = []
 
     def problem(line: int | None, msg: str) -> None:
@@ -216,9 +212,9 @@ def parse_fll(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem
     inputs = {v.name: v for v in variables if v.kind == "InputVariable"}
     outputs = [v for v in variables if v.kind == "OutputVariable"]
     for v in variables:
-        if v.kind == "InputVariable" and v.name not in INPUTS:
-            problem(v.line, f"unknown input variable {v.name!r} (inputs: {', '.join(INPUTS)})")
-    for name in INPUTS:
+        if v.kind == "InputVariable" and v.name not in sem.inputs:
+            problem(v.line, f"unknown input variable {v.name!r} (inputs: {', '.join(sem.inputs)})")
+    for name in sem.inputs:
         if name not in inputs:
             problem(engine_name[0] if engine_name else 1, f"missing InputVariable {name!r}")
     if len(outputs) != 1:
@@ -249,11 +245,11 @@ def parse_fll(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem
             problem(rng[0], f"range of {v.name} must be {num(expected[0])} {num(expected[1])}, got {rng[1]}")
 
     partitions: dict[str, InputPartition] = {}
-    for name in INPUTS:
+    for name in sem.inputs:
         v = inputs.get(name)
         if v is None:
             continue
-        check_range(v, INPUT_RANGES[name])
+        check_range(v, sem.input_ranges[name])
         part = _partition(v, problem)
         if part is not None:
             partitions[name] = part
@@ -261,19 +257,19 @@ def parse_fll(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem
     consts: list[float | None] = [None] * N_RULES
     if outputs and outputs[0].name == expected_output:
         out = outputs[0]
-        check_range(out, OUTPUT_RANGES[expected_output])
+        check_range(out, sem.output_ranges[expected_output])
         values: dict[str, float] = {}
         for n, tname, ttype, params in out.terms:
             value = _float(params[0]) if ttype == "Constant" and len(params) == 1 else None
             if value is None or not math.isfinite(value):
                 problem(n, f"output term {tname!r} must be 'Constant VALUE' with a finite value")
                 continue
-            lo, hi = OUTPUT_RANGES[expected_output]
+            lo, hi = sem.output_ranges[expected_output]
             if not lo <= value <= hi:
                 problem(n, f"constant {params[0]} outside the output range [{lo!r}, {hi!r}]")
                 continue
             values[tname] = value
-        if len(partitions) == len(INPUTS):
+        if len(partitions) == len(sem.inputs):
             seen: dict[int, int] = {}
             rule_re = re.compile(r"if\s+(.+?)\s+then\s+(\S+)\s+is\s+(\S+)(?:\s+with\s+(\S+))?\Z")
             for n, rtext in rules:
@@ -300,13 +296,13 @@ def parse_fll(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem
                     by_var[cm.group(1)] = terms.index(cm.group(2))
                 if not ok:
                     continue
-                if len(by_var) != len(INPUTS):
+                if len(by_var) != len(sem.inputs):
                     problem(n, "every rule must name all four inputs")
                     continue
                 if m.group(2) != expected_output or m.group(3) not in values:
                     problem(n, f"consequent '{m.group(2)} is {m.group(3)}' is not a Constant term of {expected_output}")
                     continue
-                r = rule_index([by_var[name] for name in INPUTS])
+                r = rule_index([by_var[name] for name in sem.inputs])
                 if r in seen:
                     problem(n, f"duplicate rule: same conditions as line {seen[r]}")
                     continue
@@ -319,7 +315,7 @@ def parse_fll(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem
         return None, meta, problems
     fis = FuzzySystem(
         output=expected_output,
-        inputs=tuple(partitions[name] for name in INPUTS),
+        inputs=tuple(partitions[name] for name in sem.inputs),
         consts=tuple(consts),
     )
     return fis, meta, []
@@ -343,7 +339,7 @@ def _partition(v: _Var, problem) -> InputPartition | None:
             return None
         shapes.append((shape[1], shape, tname, n))
     shapes.sort(key=lambda s: s[0])
-    lo, hi = INPUT_RANGES[v.name]
+    lo, hi = _sem.ALL_INPUT_RANGES[v.name]
     peaks = [s[0] for s in shapes]
     # infinite shoulders: -inf / +inf feet are fine at the ends
     problem_text = peaks_problem(tuple(peaks), lo, hi)
@@ -380,21 +376,27 @@ def import_fll(
     problems: list[Problem] = []
     systems = []
     meta: dict = {}
-    for output in OUTPUTS:
+    # which semantics: the one whose second output's file is present (the first, goal_bias,
+    # is shared); the export's description line says it too
+    sem = next((s for s in _sem.SEMANTICS.values() if (root / fll_file_name(s.outputs[1])).is_file()),
+               _sem.PAPER)
+    for output in sem.outputs:
         file = root / fll_file_name(output)
         try:
             data = file.read_bytes()
         except OSError as exc:
             problems.append((str(file), None, "missing file" if isinstance(exc, FileNotFoundError) else f"cannot read: {exc}"))
             continue
-        fis, file_meta, found = parse_fll(data, str(file), output)
+        fis, file_meta, found = parse_fll(data, str(file), output, sem)
         problems.extend(found)
         systems.append(fis)
         meta = meta or file_meta
     if problems:
         raise RulebookError(problems)
     mode = bounds_mode or meta.get("bounds_mode") or "absolute"
-    if mode not in ("absolute", "relative"):
+    if sem is not _sem.PAPER:
+        mode = None
+    elif mode not in ("absolute", "relative"):
         raise RulebookError([(str(root), None, f"bounds mode must be absolute or relative, got {mode!r}")])
     provenance = {
         "kind": "imported-fll",
@@ -413,4 +415,5 @@ def import_fll(
         bounds_mode=mode,
         systems=tuple(systems),
         provenance=provenance,
+        semantics=sem,
     )

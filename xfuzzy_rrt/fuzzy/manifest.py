@@ -30,6 +30,7 @@ degrees (the paper's reading) or ``"relative"`` offsets from the current nearest
 from __future__ import annotations
 
 import datetime as _dt
+import difflib
 import math
 import re
 import tomllib
@@ -37,14 +38,14 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any, Mapping
 
+from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.fuzzy.text_format import SUFFIX
-from xfuzzy_rrt.fuzzy.variables import OUTPUTS
 
 MANIFEST_NAME = "rulebook.toml"
 FORMAT_NAME = "xfuzzy-rrt-rulebook"
 FORMAT_VERSION = 1
 BOUNDS_MODES = ("absolute", "relative")
-TOP_KEYS = ("format", "format_version", "name", "bounds_mode", "description")
+TOP_KEYS = ("format", "format_version", "name", "semantics", "bounds_mode", "description")
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+\Z")
 
 Problem = tuple[str, "int | None", str]
@@ -73,15 +74,21 @@ class Manifest:
     """The validated contents of ``rulebook.toml``."""
 
     name: str
-    bounds_mode: str
+    bounds_mode: str | None
     provenance: Mapping[str, Any] = field(default_factory=dict)
     description: str = ""
+    semantics: str = "paper"
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
             raise ValueError("rulebook name must be a non-empty string")
-        if self.bounds_mode not in BOUNDS_MODES:
-            raise ValueError(f"bounds_mode must be one of {BOUNDS_MODES}, got {self.bounds_mode!r}")
+        _sem.get(self.semantics)  # raises ValueError when unknown
+        if self.semantics == _sem.PAPER.name:
+            if self.bounds_mode not in BOUNDS_MODES:
+                raise ValueError(f"bounds_mode must be one of {BOUNDS_MODES}, got {self.bounds_mode!r}")
+        elif self.bounds_mode is not None:
+            raise ValueError(f"bounds_mode belongs to the paper's semantics; a {self.semantics} "
+                             f"rulebook has none (got {self.bounds_mode!r})")
         if not isinstance(self.description, str):
             raise ValueError("description must be a string")
         if not isinstance(self.provenance, Mapping):
@@ -168,15 +175,20 @@ def _toml_table_lines(path: list[str], table: Mapping[str, Any]) -> list[str]:
 
 
 def format_manifest(m: Manifest) -> str:
-    """Canonical text of a manifest."""
-    first, last = OUTPUTS[0], OUTPUTS[-1]
+    """Canonical text of a manifest (``semantics`` is written only when it is not the paper's,
+    so every paper-semantics rulebook keeps its bytes and its SHA-256)."""
+    outputs = _sem.get(m.semantics).outputs
+    first, last = outputs[0], outputs[-1]
     lines = [
         f"# xfuzzy-rrt rulebook manifest; the six FIS files ({first}{SUFFIX} ... {last}{SUFFIX}) sit beside it.",
         f"format = {_toml_string(FORMAT_NAME)}",
         f"format_version = {FORMAT_VERSION}",
         f"name = {_toml_string(m.name)}",
-        f"bounds_mode = {_toml_string(m.bounds_mode)}",
     ]
+    if m.semantics != _sem.PAPER.name:
+        lines.append(f"semantics = {_toml_string(m.semantics)}")
+    if m.bounds_mode is not None:
+        lines.append(f"bounds_mode = {_toml_string(m.bounds_mode)}")
     if m.description:
         lines.append(f"description = {_toml_string(m.description)}")
     lines.append("")
@@ -235,7 +247,9 @@ def parse_manifest(data: bytes, file: str) -> tuple[Manifest | None, list[Proble
 
     for key in doc:
         if key not in TOP_KEYS and key != "provenance":
-            problem(key, f"unknown key {key!r} (expected {', '.join(TOP_KEYS)} and [provenance])")
+            near = difflib.get_close_matches(key, [*TOP_KEYS, "provenance"], n=1)
+            hint = f" (did you mean {near[0]!r}?)" if near else ""
+            problem(key, f"unknown key {key!r}{hint}; known: {', '.join(TOP_KEYS)} and [provenance]")
     fmt = doc.get("format")
     if fmt is None:
         problems.append((file, 1, f'missing key format = "{FORMAT_NAME}"'))
@@ -251,8 +265,16 @@ def parse_manifest(data: bytes, file: str) -> tuple[Manifest | None, list[Proble
         problems.append((file, 1, "missing key name"))
     elif not isinstance(name, str) or not name.strip():
         problem("name", f"name must be a non-empty string, got {name!r}")
+    sem_name = doc.get("semantics", _sem.PAPER.name)
+    if sem_name not in _sem.SEMANTICS:
+        problem("semantics", f"semantics must be one of {', '.join(map(repr, _sem.SEMANTICS))}, got {sem_name!r}")
+        sem_name = _sem.PAPER.name
     mode = doc.get("bounds_mode")
-    if mode is None:
+    if sem_name != _sem.PAPER.name:
+        if mode is not None:
+            problem("bounds_mode", f"bounds_mode belongs to the paper's semantics; remove it "
+                                   f"from a {sem_name} rulebook")
+    elif mode is None:
         problems.append((file, 1, f"missing key bounds_mode ({' or '.join(BOUNDS_MODES)})"))
     elif mode not in BOUNDS_MODES:
         problem("bounds_mode", f"bounds_mode must be {' or '.join(repr(b) for b in BOUNDS_MODES)}, got {mode!r}")
@@ -273,4 +295,5 @@ def parse_manifest(data: bytes, file: str) -> tuple[Manifest | None, list[Proble
             )
     if problems:
         return None, problems
-    return Manifest(name=name, bounds_mode=mode, provenance=prov, description=description), []
+    return Manifest(name=name, bounds_mode=mode, provenance=prov, description=description,
+                    semantics=sem_name), []

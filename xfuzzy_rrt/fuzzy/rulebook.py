@@ -44,17 +44,10 @@ from xfuzzy_rrt.fuzzy.manifest import (
     format_manifest,
     parse_manifest,
 )
+from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.fuzzy.system import FuzzySystem, InputPartition
 from xfuzzy_rrt.fuzzy.text_format import SUFFIX, format_fis, parse_fis
-from xfuzzy_rrt.fuzzy.variables import (
-    DEFAULT_TERMS,
-    INPUTS,
-    N_INPUTS,
-    N_OUTPUTS,
-    N_RULES,
-    N_TERMS,
-    OUTPUTS,
-)
+from xfuzzy_rrt.fuzzy.variables import N_INPUTS, N_OUTPUTS, N_RULES, N_TERMS
 
 #: Environment variable naming a folder of rulebooks that replaces the shipped one.
 RULEBOOKS_ENV = "XFUZZY_RRT_RULEBOOKS"
@@ -83,25 +76,40 @@ def fis_file_name(output: str) -> str:
 
 @dataclass(frozen=True)
 class Rulebook:
-    """Six single-output TSK systems (OUTPUTS order) with a name, bounds mode and provenance."""
+    """Six single-output TSK systems (the semantics' output order) with a name, semantics,
+    bounds mode (paper semantics only; ``None`` otherwise) and provenance.
+
+    ``semantics`` is a :class:`~.semantics.Semantics` (or its name): it fixes the input and
+    output names, ranges and units every tool reads.
+    """
 
     name: str
-    bounds_mode: str
+    bounds_mode: str | None
     systems: tuple[FuzzySystem, ...]
     provenance: Mapping[str, Any] = field(default_factory=dict)
     description: str = ""
+    semantics: "_sem.Semantics | str | None" = None  # None: the systems' own semantics
 
     def __post_init__(self) -> None:
+        if self.semantics is None:
+            first = self.systems[0] if len(self.systems) else None
+            sem = first.semantics if isinstance(first, FuzzySystem) else _sem.PAPER
+        elif isinstance(self.semantics, _sem.Semantics):
+            sem = self.semantics
+        else:
+            sem = _sem.get(self.semantics)
+        object.__setattr__(self, "semantics", sem)
         object.__setattr__(self, "systems", tuple(self.systems))
-        outputs = tuple(s.output for s in self.systems)
-        if outputs != OUTPUTS:
-            raise ValueError(f"systems must be {OUTPUTS} in that order, got {outputs}")
         for s in self.systems:
             if not isinstance(s, FuzzySystem):
                 raise ValueError(f"systems must be FuzzySystem objects, got {type(s).__name__}")
+        outputs = tuple(s.output for s in self.systems)
+        if outputs != sem.outputs or any(s.semantics is not sem for s in self.systems):
+            raise ValueError(f"systems must be {sem.outputs} of the {sem.name} semantics in that "
+                             f"order, got {outputs}")
         manifest = Manifest(
             name=self.name, bounds_mode=self.bounds_mode,
-            provenance=self.provenance, description=self.description,
+            provenance=self.provenance, description=self.description, semantics=sem.name,
         )  # validates; also freezes provenance
         object.__setattr__(self, "provenance", manifest.provenance)
 
@@ -111,7 +119,7 @@ class Rulebook:
         from xfuzzy_rrt.fuzzy.manifest import thaw
 
         return (_rebuild, (self.name, self.bounds_mode, self.systems, thaw(self.provenance),
-                           self.description))
+                           self.description, self.semantics.name))
 
     # ------------------------------------------------------------------ views
 
@@ -120,14 +128,25 @@ class Rulebook:
         return Manifest(
             name=self.name, bounds_mode=self.bounds_mode,
             provenance=self.provenance, description=self.description,
+            semantics=self.semantics.name,
         )
 
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        """Input names, in rule-index order."""
+        return self.semantics.inputs
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        """Output names, in system order."""
+        return self.semantics.outputs
+
     def system(self, output: str) -> FuzzySystem:
-        """The FIS for *output* (one of OUTPUTS)."""
+        """The FIS for *output* (one of :attr:`outputs`)."""
         try:
-            return self.systems[OUTPUTS.index(output)]
+            return self.systems[self.outputs.index(output)]
         except ValueError:
-            raise KeyError(f"unknown output {output!r}; outputs are {OUTPUTS}") from None
+            raise KeyError(f"unknown output {output!r}; outputs are {self.outputs}") from None
 
     def texts(self, compact: bool = False) -> dict[str, str]:
         """Canonical text of every file, keyed by file name (manifest first, then OUTPUTS).
@@ -181,10 +200,11 @@ class Rulebook:
         consts,
         *,
         name: str,
-        bounds_mode: str,
+        bounds_mode: str | None,
         provenance: Mapping[str, Any] | None = None,
         description: str = "",
         term_names: Mapping[str, tuple[str, ...]] | None = None,
+        semantics: "_sem.Semantics | str" = _sem.PAPER,
     ) -> "Rulebook":
         """Build a rulebook from engine arrays (what the GA trainer evolves).
 
@@ -199,36 +219,44 @@ class Rulebook:
             raise ValueError(f"knots must have shape {(N_OUTPUTS, N_INPUTS, N_TERMS)}, got {knots.shape}")
         if consts.shape != (N_OUTPUTS, N_RULES):
             raise ValueError(f"consts must have shape {(N_OUTPUTS, N_RULES)}, got {consts.shape}")
-        names = dict(DEFAULT_TERMS)
+        sem = semantics if isinstance(semantics, _sem.Semantics) else _sem.get(semantics)
+        names = dict(sem.default_terms)
         if term_names:
             names.update({k: tuple(v) for k, v in term_names.items()})
         systems = []
-        for f, output in enumerate(OUTPUTS):
+        for f, output in enumerate(sem.outputs):
             inputs = tuple(
                 InputPartition(name=inp, terms=names[inp], peaks=tuple(knots[f, i].tolist()))
-                for i, inp in enumerate(INPUTS)
+                for i, inp in enumerate(sem.inputs)
             )
             systems.append(FuzzySystem(output=output, inputs=inputs, consts=tuple(consts[f].tolist())))
         return cls(
             name=name, bounds_mode=bounds_mode, systems=tuple(systems),
-            provenance=dict(provenance or {}), description=description,
+            provenance=dict(provenance or {}), description=description, semantics=sem,
         )
 
 
-def _rebuild(name, bounds_mode, systems, provenance, description) -> "Rulebook":
+def _rebuild(name, bounds_mode, systems, provenance, description, semantics="paper") -> "Rulebook":
     return Rulebook(name=name, bounds_mode=bounds_mode, systems=systems, provenance=provenance,
-                    description=description)
+                    description=description, semantics=semantics)
 
 
 # ------------------------------------------------------------------------- locations
 
 
 def rulebooks_dir() -> Path:
-    """Folder holding the shipped rulebooks (``$XFUZZY_RRT_RULEBOOKS`` overrides it)."""
+    """Folder holding the shipped rulebooks (``$XFUZZY_RRT_RULEBOOKS`` overrides it).
+
+    The shipped ones are package data (``xfuzzy_rrt.rulebooks``, the top-level ``rulebooks/``
+    folder of a checkout), located through ``importlib.resources`` so that an installed wheel
+    finds its own copy (see :mod:`xfuzzy_rrt.resources`).
+    """
     env = os.environ.get(RULEBOOKS_ENV)
     if env:
         return Path(env)
-    return Path(__file__).resolve().parents[2] / "rulebooks"
+    from xfuzzy_rrt.resources import shipped_rulebooks_dir
+
+    return shipped_rulebooks_dir()
 
 
 def default_rulebook_path() -> Path:
@@ -236,35 +264,44 @@ def default_rulebook_path() -> Path:
     return rulebooks_dir() / DEFAULT_RULEBOOK
 
 
-def _stamp(root: Path) -> tuple:
-    """What identifies a rulebook directory's current contents cheaply (no reading)."""
-    out = []
-    for name in [MANIFEST_NAME, *(fis_file_name(o) for o in OUTPUTS)]:
+def _content_key(root: Path) -> str:
+    """SHA-256 over the bytes of the manifest and every FIS file (a missing one counts).
+
+    Why the bytes, not (mtime, size, inode): ``cp -p``, ``rsync -t`` or ``tar x`` can put
+    different bytes of the same size under the same modification time, and a stale rulebook
+    would then plan silently. Hashing seven small files costs well under a millisecond against
+    ~100 ms of parsing.
+    """
+    h = hashlib.sha256()
+    fis_names = sorted(p.name for p in root.glob("*" + SUFFIX)) if root.is_dir() else []
+    for name in [MANIFEST_NAME, *fis_names]:
         try:
-            st = (root / name).stat()
-            out.append((name, st.st_mtime_ns, st.st_size, st.st_ino))
+            data = (root / name).read_bytes()
         except OSError:
-            out.append((name, None, None, None))
-    return tuple(out)
+            h.update(f"{name}\n-\n".encode())
+            continue
+        h.update(f"{name}\n{len(data)}\n".encode())
+        h.update(data)
+    return h.hexdigest()
 
 
 @functools.lru_cache(maxsize=16)
-def _load_cached(root: str, stamp: tuple) -> "Rulebook":
+def _load_cached(root: str, content: str) -> "Rulebook":
     return load_rulebook(root)
 
 
 def load_rulebook_cached(path: str | os.PathLike[str]) -> "Rulebook":
-    """:func:`load_rulebook`, but parse a directory only once while its files are unchanged.
+    """:func:`load_rulebook`, but parse a directory only once while its files' bytes are unchanged.
 
     Why: library callers plan many times with the default rulebook; parsing 3,750 rules costs
-    ~50 ms, a plan ~1 ms. The cache key includes each file's modification time, size and
-    inode, so editing (or atomically replacing) a file is seen by the next call. Rulebooks are
-    immutable, so sharing one object between calls is safe.
+    ~50-130 ms, a plan ~1 ms. The cache key is the hash of the files' contents, so any edit is
+    seen by the next call whatever it does to timestamps. Rulebooks are immutable, so sharing
+    one object between calls is safe.
     """
     root = Path(path).resolve()
     if not root.is_dir():
         return load_rulebook(root)  # raises the usual one-line error
-    return _load_cached(str(root), _stamp(root))
+    return _load_cached(str(root), _content_key(root))
 
 
 def list_rulebooks() -> list[Path]:
@@ -302,41 +339,44 @@ def load_rulebook(path: str | os.PathLike[str]) -> Rulebook:
     if not root.is_dir():
         raise RulebookError([(str(root), None, "not a directory (a rulebook is a directory)")])
     problems: list[tuple[str, int | None, str]] = []
-    expected = [MANIFEST_NAME, *(fis_file_name(o) for o in OUTPUTS)]
+    all_outputs = {o for s in _sem.SEMANTICS.values() for o in s.outputs}
+    expected = [MANIFEST_NAME, *(fis_file_name(o) for o in sorted(all_outputs))]
     if not any((root / name).exists() for name in expected):
         # Not a damaged rulebook but no rulebook at all: one line, not seven "missing file"s.
         raise RulebookError([(str(root), None, f"not a rulebook directory (no {MANIFEST_NAME} "
                               f"and no {SUFFIX} files)")])
-    try:
-        extra = sorted(
-            p.name for p in root.iterdir()
-            if p.suffix == SUFFIX and p.stem not in OUTPUTS
-        )
-    except OSError as exc:
-        raise RulebookError([(str(root), None, f"cannot list directory: {exc.strerror or exc}")]) from None
-    for name in extra:
-        problems.append(
-            (str(root / name), None, f"unexpected FIS file (outputs are {', '.join(OUTPUTS)})")
-        )
     manifest = None
     data = _read(root / MANIFEST_NAME, problems)
     if data is not None:
         manifest, found = parse_manifest(data, str(root / MANIFEST_NAME))
         problems.extend(found)
+    sem = _sem.get(manifest.semantics) if manifest is not None else _sem.PAPER
+    try:
+        extra = sorted(
+            p.name for p in root.iterdir()
+            if p.suffix == SUFFIX and p.stem not in sem.outputs
+        )
+    except OSError as exc:
+        raise RulebookError([(str(root), None, f"cannot list directory: {exc.strerror or exc}")]) from None
+    for name in extra:
+        problems.append(
+            (str(root / name), None, f"unexpected FIS file (the {sem.name} semantics' outputs "
+                                     f"are {', '.join(sem.outputs)})")
+        )
     systems = []
-    for output in OUTPUTS:
+    for output in sem.outputs:
         file = root / fis_file_name(output)
         data = _read(file, problems)
         if data is None:
             continue
-        fis, found = parse_fis(data, str(file), output)
+        fis, found = parse_fis(data, str(file), output, sem)
         problems.extend(found)
         systems.append(fis)
     if problems:
         raise RulebookError(problems)
     return Rulebook(
         name=manifest.name, bounds_mode=manifest.bounds_mode, systems=tuple(systems),
-        provenance=manifest.provenance, description=manifest.description,
+        provenance=manifest.provenance, description=manifest.description, semantics=sem,
     )
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.fuzzy.variables import INPUTS, N_RULES, rule_terms
+from xfuzzy_rrt.fuzzy.variables import N_RULES, rule_terms
 
 
 @dataclass(frozen=True)
@@ -53,9 +53,10 @@ def parse_conditions(conditions: list[str], rulebook) -> dict[int, int]:
             var, sep, term = (p.strip() for p in part.partition("="))
             if not sep:
                 raise InputError("--when", f"expected INPUT=TERM, got {part!r}")
-            if var not in INPUTS:
-                raise InputError("--when", f"unknown input {var!r} (inputs: {', '.join(INPUTS)})")
-            i = INPUTS.index(var)
+            names = rulebook.inputs
+            if var not in names:
+                raise InputError("--when", f"unknown input {var!r} (inputs: {', '.join(names)})")
+            i = names.index(var)
             if term not in inputs[i].terms:
                 raise InputError("--when", f"unknown term {term!r} for {var} (terms: {' '.join(inputs[i].terms)})")
             out[i] = inputs[i].terms.index(term)

@@ -12,14 +12,8 @@ import math
 import re
 from dataclasses import dataclass
 
-from xfuzzy_rrt.fuzzy.variables import (
-    INPUT_RANGES,
-    INPUTS,
-    N_RULES,
-    N_TERMS,
-    OUTPUT_RANGES,
-    OUTPUTS,
-)
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.fuzzy.variables import N_RULES, N_TERMS
 
 #: Term names are identifiers (letters, digits, underscores; not starting with a digit) and
 #: cannot be one of the words the rule grammar uses.
@@ -69,8 +63,9 @@ class InputPartition:
     peaks: tuple[float, ...]
 
     def __post_init__(self) -> None:
-        if self.name not in INPUT_RANGES:
-            raise ValueError(f"unknown input variable {self.name!r}; inputs are {INPUTS}")
+        if self.name not in _sem.ALL_INPUT_RANGES:
+            raise ValueError(f"unknown input variable {self.name!r}; inputs are "
+                             f"{', '.join(_sem.ALL_INPUT_RANGES)}")
         object.__setattr__(self, "terms", tuple(str(t) for t in self.terms))
         object.__setattr__(self, "peaks", tuple(float(p) for p in self.peaks))
         if len(self.terms) != N_TERMS:
@@ -87,8 +82,8 @@ class InputPartition:
 
     @property
     def range(self) -> tuple[float, float]:
-        """The variable's range (fixed by SPEC.md, not per rulebook)."""
-        return INPUT_RANGES[self.name]
+        """The variable's range (fixed by its semantics, not per rulebook)."""
+        return _sem.ALL_INPUT_RANGES[self.name]
 
 
 @dataclass(frozen=True)
@@ -103,13 +98,16 @@ class FuzzySystem:
     consts: tuple[float, ...]
 
     def __post_init__(self) -> None:
-        if self.output not in OUTPUT_RANGES:
-            raise ValueError(f"unknown output variable {self.output!r}; outputs are {OUTPUTS}")
         object.__setattr__(self, "inputs", tuple(self.inputs))
         object.__setattr__(self, "consts", tuple(float(c) for c in self.consts))
         names = tuple(i.name for i in self.inputs)
-        if names != INPUTS:
-            raise ValueError(f"{self.output}: inputs must be {INPUTS} in that order, got {names}")
+        sem = _sem.of_inputs(names[0]) if names else None
+        if sem is None or names != sem.inputs:
+            raise ValueError(f"{self.output}: inputs must be those of one semantics in order "
+                             f"(e.g. {_sem.PAPER.inputs}), got {names}")
+        if self.output not in sem.outputs:
+            raise ValueError(f"unknown output variable {self.output!r} for the {sem.name} "
+                             f"semantics; outputs are {sem.outputs}")
         if len(self.consts) != N_RULES:
             raise ValueError(f"{self.output}: expected {N_RULES} rule constants, got {len(self.consts)}")
         lo, hi = self.range
@@ -120,6 +118,11 @@ class FuzzySystem:
                 )
 
     @property
+    def semantics(self) -> "_sem.Semantics":
+        """The semantics this system's inputs belong to."""
+        return _sem.of_inputs(self.inputs[0].name)
+
+    @property
     def range(self) -> tuple[float, float]:
-        """The output's range (fixed by SPEC.md)."""
-        return OUTPUT_RANGES[self.output]
+        """The output's range (fixed by the semantics)."""
+        return self.semantics.output_ranges[self.output]

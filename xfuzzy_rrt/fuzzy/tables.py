@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.fuzzy.variables import INPUTS, OUTPUTS
+from xfuzzy_rrt.fuzzy.variables import INPUTS
 
 
 def _to_float(text: str) -> float:
@@ -23,7 +23,7 @@ def _to_float(text: str) -> float:
         return float("nan")
 
 
-def read_inputs_csv(path: str | os.PathLike[str]):
+def read_inputs_csv(path: str | os.PathLike[str], inputs: tuple[str, ...] = INPUTS):
     """Read a CSV with (at least) the four input columns; return a pandas DataFrame.
 
     Numbers are parsed with Python's ``float`` (correctly rounded), so values written with 17
@@ -43,10 +43,10 @@ def read_inputs_csv(path: str | os.PathLike[str]):
     except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
         raise InputError(file, f"not a readable CSV: {str(exc).strip()}") from None
     df.columns = [str(c).strip() for c in df.columns]
-    missing = [c for c in INPUTS if c not in df.columns]
+    missing = [c for c in inputs if c not in df.columns]
     if missing:
-        raise InputError(file, f"missing column(s) {', '.join(missing)} (need {', '.join(INPUTS)})")
-    for col in INPUTS:
+        raise InputError(file, f"missing column(s) {', '.join(missing)} (need {', '.join(inputs)})")
+    for col in inputs:
         text = df[col].astype(str).str.strip()
         values = np.fromiter((_to_float(v) for v in text), dtype=np.float64, count=len(text))
         bad = ~np.isfinite(values)
@@ -62,9 +62,9 @@ def evaluate_frame(rulebook, df):
     from xfuzzy_rrt.fuzzy.engine import evaluate
 
     knots, consts = rulebook.arrays()
-    X = np.ascontiguousarray(df[list(INPUTS)].to_numpy(dtype=np.float64))
-    Y = evaluate(knots, consts, X) if len(X) else np.empty((0, len(OUTPUTS)))
+    X = np.ascontiguousarray(df[list(rulebook.inputs)].to_numpy(dtype=np.float64))
+    Y = evaluate(knots, consts, X) if len(X) else np.empty((0, len(rulebook.outputs)))
     out = df.copy()
-    for j, name in enumerate(OUTPUTS):
+    for j, name in enumerate(rulebook.outputs):
         out[name] = Y[:, j]
     return out

@@ -83,15 +83,8 @@ from xfuzzy_rrt.fuzzy.system import (
     peaks_problem,
     term_name_problem,
 )
-from xfuzzy_rrt.fuzzy.variables import (
-    INPUT_RANGES,
-    INPUTS,
-    N_RULES,
-    N_TERMS,
-    OUTPUT_RANGES,
-    rule_index,
-    rule_terms,
-)
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.fuzzy.variables import N_RULES, N_TERMS, rule_index, rule_terms
 
 FORMAT_NAME = "xfuzzy-rrt-fis"
 FORMAT_VERSION = 1
@@ -125,9 +118,17 @@ def _parse_float(text: str) -> float | None:
 # --------------------------------------------------------------------------------- format
 
 
-def header_comment(output: str) -> list[str]:
+_UNITS_NOTE = {
+    "paper": ["# clamped to it. Angles are workspace directions counter-clockwise from +x in radians",
+              "# (0 and 2*pi are both east); distances are in metres."],
+    "goal-frame": ["# clamped to it. Goal-frame semantics: joint_dist_to_goal and clearance_deg are in",
+                   "# joint-space degrees, stagnation in iterations, reject_rate a share (0..1)."],
+}
+
+
+def header_comment(output: str, sem: "_sem.Semantics" = _sem.PAPER) -> list[str]:
     """The fixed explanatory comment at the top of every canonical FIS file."""
-    lo, hi = OUTPUT_RANGES[output]
+    lo, hi = sem.output_ranges[output]
     return [
         f"# xfuzzy-rrt fuzzy inference system: {output} (range {fnum(lo)} .. {fnum(hi)})",
         "#",
@@ -135,8 +136,7 @@ def header_comment(output: str) -> list[str]:
         f"# {output} is the firing-weighted average of the rule constants.",
         "# Each input has five terms; term j peaks at peaks[j] and falls to 0 at the",
         "# neighbouring peaks (the first and last are shoulders). Inputs outside a range are",
-        "# clamped to it. Angles are workspace directions counter-clockwise from +x in radians",
-        "# (0 and 2*pi are both east); distances are in metres.",
+        *_UNITS_NOTE[sem.name],
         "# Rules: one per line, in index order r = ((t0*5 + t1)*5 + t2)*5 + t3 (t = term index).",
         "# Edit numbers freely; '#' comments are ignored but not kept when a tool saves the file.",
     ]
@@ -164,7 +164,7 @@ def format_fis(fis: FuzzySystem, compact: bool = False) -> str:
     625 constants (see the module docstring).
     """
     lo, hi = fis.range
-    lines = header_comment(fis.output)
+    lines = header_comment(fis.output, fis.semantics)
     if compact:
         lines += [
             "# Compact layout: 'INPUT is any' matches every term of that input; after expanding",
@@ -219,6 +219,7 @@ class _InputDecl:
 class _State:
     file: str
     expected_output: str
+    sem: "_sem.Semantics" = _sem.PAPER
     problems: list[Problem] = field(default_factory=list)
     saw_format: bool = False
     output_line: int | None = None
@@ -260,14 +261,16 @@ def decode_lines(data: bytes, file: str) -> tuple[list[str | None], list[Problem
     return lines, problems
 
 
-def parse_fis(data: bytes, file: str, expected_output: str) -> tuple[FuzzySystem | None, list[Problem]]:
+def parse_fis(data: bytes, file: str, expected_output: str,
+              semantics: "_sem.Semantics" = _sem.PAPER) -> tuple[FuzzySystem | None, list[Problem]]:
     """Parse one FIS file. Returns the system (``None`` if anything is wrong) and all problems.
 
     *file* is the name used in problem messages; *expected_output* is the output this file must
-    describe (its stem).
+    describe (its stem); *semantics* (from the rulebook manifest) fixes the input names, their
+    order and every range.
     """
     lines, problems = decode_lines(data, file)
-    st = _State(file=file, expected_output=expected_output, problems=problems)
+    st = _State(file=file, expected_output=expected_output, sem=semantics, problems=problems)
     raw_lines = data.split(b"\n") if problems else []
     last_line = 0
     for n, raw in enumerate(lines, start=1):
@@ -337,7 +340,7 @@ def _output(st: _State, n: int, words: list[str]) -> None:
     if name != st.expected_output:
         st.problem(n, f"wrong output variable {name!r}: this file describes {st.expected_output!r}")
         return
-    problem = _range_problem(words, OUTPUT_RANGES[name], name)
+    problem = _range_problem(words, st.sem.output_ranges[name], name)
     if problem:
         st.problem(n, problem)
     st.output_ok = True
@@ -346,20 +349,24 @@ def _output(st: _State, n: int, words: list[str]) -> None:
 def _input(st: _State, n: int, words: list[str]) -> None:
     k = len(st.inputs)
     name = words[1] if len(words) > 1 else ""
-    expected = INPUTS[k] if k < len(INPUTS) else None
+    inputs = st.sem.inputs
+    expected = inputs[k] if k < len(inputs) else None
     if expected is None:
-        st.problem(n, f"too many inputs: {name!r} (a FIS has exactly {len(INPUTS)}: {', '.join(INPUTS)})")
+        st.problem(n, f"too many inputs: {name!r} (a FIS has exactly {len(inputs)}: {', '.join(inputs)})")
         st.inputs.append(_InputDecl(name=name, line=n))
         return
     decl = _InputDecl(name=name, line=n)
     st.inputs.append(decl)
     if name != expected:
-        hint = "unknown input variable" if name not in INPUTS else "input out of order"
+        hint = "unknown input variable" if name not in inputs else "input out of order"
+        other = _sem.of_input(name)
+        if other is not None and other is not st.sem:
+            hint = f"input of the {other.name} semantics (the manifest says {st.sem.name})"
         st.problem(n, f"{hint} {name!r} (input {k + 1} must be {expected!r})")
         decl.name = expected  # check the rest as if it were the expected one
         decl.line = n
         return
-    problem = _range_problem(words, INPUT_RANGES[name], name)
+    problem = _range_problem(words, st.sem.input_ranges[name], name)
     if problem:
         st.problem(n, problem)
 
@@ -396,7 +403,7 @@ def _input_detail(st: _State, n: int, key: str, words: list[str]) -> None:
         if bad:
             st.problem(n, f"peak {bad[0]!r} of {decl.name!r} is not a finite number")
             return
-        lo, hi = INPUT_RANGES.get(decl.name, (math.nan, math.nan))
+        lo, hi = st.sem.input_ranges.get(decl.name, (math.nan, math.nan))
         problem = peaks_problem(decl.peaks, lo, hi)
         if problem:
             st.problem(n, f"{decl.name}: {problem}")
@@ -423,8 +430,8 @@ def _rule(st: _State, n: int, text: str) -> None:
             ok = False
             continue
         var, term = cm.group("var"), cm.group("term")
-        if var not in INPUTS:
-            st.problem(n, f"unknown input variable {var!r} in rule (inputs: {', '.join(INPUTS)})")
+        if var not in st.sem.inputs:
+            st.problem(n, f"unknown input variable {var!r} in rule (inputs: {', '.join(st.sem.inputs)})")
             ok = False
             continue
         if var in by_var:
@@ -432,13 +439,13 @@ def _rule(st: _State, n: int, text: str) -> None:
             ok = False
             continue
         by_var[var] = term
-    missing = [v for v in INPUTS if v not in by_var]
+    missing = [v for v in st.sem.inputs if v not in by_var]
     if ok and missing:
         st.problem(n, f"rule has no condition on {', '.join(missing)} (every rule names all four inputs)")
         ok = False
     t_idx: list[int] = []
-    decls = {d.name: d for d in st.inputs[: len(INPUTS)]}
-    for var in INPUTS:
+    decls = {d.name: d for d in st.inputs[: len(st.sem.inputs)]}
+    for var in st.sem.inputs:
         if var not in by_var:
             continue
         decl = decls.get(var)
@@ -458,12 +465,12 @@ def _rule(st: _State, n: int, text: str) -> None:
     if out != st.expected_output:
         st.problem(n, f"rule concludes {out!r} but this file describes {st.expected_output!r}")
     value = _parse_float(m.group("value"))
-    lo, hi = OUTPUT_RANGES[st.expected_output]
+    lo, hi = st.sem.output_ranges[st.expected_output]
     if value is None:
         st.problem(n, f"consequent {m.group('value')!r} is not a finite number")
     elif not lo <= value <= hi:
         st.problem(n, f"consequent {m.group('value')} outside the output range [{fnum(lo)}, {fnum(hi)}] of {st.expected_output}")
-    if not ok or len(t_idx) != len(INPUTS):
+    if not ok or len(t_idx) != len(st.sem.inputs):
         return
     label = m.group("label")
     if ANY in t_idx:
@@ -507,7 +514,7 @@ def _any_rule(st: _State, n: int, pattern: tuple[int, ...], label: str | None,
 
 def _cell_text(st: _State, r: int) -> str:
     t = rule_terms(r)
-    decls = st.inputs[: len(INPUTS)]
+    decls = st.inputs[: len(st.sem.inputs)]
     return " and ".join(f"{d.name} is {d.terms[t[k]]}" for k, d in enumerate(decls))
 
 
@@ -519,15 +526,15 @@ def _finish(st: _State, n_lines: int, last_line: int) -> None:
         return
     if st.output_line is None:
         st.problem(at_end, f"missing 'output {st.expected_output} range LO HI' declaration")
-    for decl in st.inputs[: len(INPUTS)]:
+    for decl in st.inputs[: len(st.sem.inputs)]:
         if decl.terms is None:
             st.problem(decl.line, f"input {decl.name!r} has no 'terms' line")
         if decl.peaks is None:
             st.problem(decl.line, f"input {decl.name!r} has no 'peaks' line")
-    for name in INPUTS[len(st.inputs):]:
+    for name in st.sem.inputs[len(st.inputs):]:
         st.problem(at_end, f"missing declaration of input {name!r}")
-    inputs_ok = len(st.inputs) >= len(INPUTS) and all(
-        d.terms_ok for d in st.inputs[: len(INPUTS)]
+    inputs_ok = len(st.inputs) >= len(st.sem.inputs) and all(
+        d.terms_ok for d in st.inputs[: len(st.sem.inputs)]
     )
     if inputs_ok:
         _report_missing_rules(st, at_end)
@@ -552,7 +559,7 @@ def _report_missing_rules(st: _State, at_end: int) -> None:
             start = r
         prev = r
     runs.append((start, prev))
-    decls = st.inputs[: len(INPUTS)]
+    decls = st.inputs[: len(st.sem.inputs)]
     for a, b in runs:
         # the line of the next present rule (where the missing one belongs), else the end
         i = bisect.bisect_right(present, b)
@@ -571,7 +578,7 @@ def _report_gaps(st: _State, present: list[int], missing: list[int], at_end: int
     mask = [False] * N_RULES
     for r in missing:
         mask[r] = True
-    decls = st.inputs[: len(INPUTS)]
+    decls = st.inputs[: len(st.sem.inputs)]
     for pattern in greedy_gap_patterns(mask):
         cells = pattern_cells(pattern)
         a, b = int(cells[0]), int(cells[-1])

@@ -63,6 +63,24 @@ from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path, nearest
 MIN_STEP_DEG = 0.5
 BOUNDS_ABSOLUTE = 0
 BOUNDS_RELATIVE = 1
+#: Kernel mode of a goal-frame rulebook (see :mod:`xfuzzy_rrt.planners.goal_frame`).
+GOAL_FRAME = 2
+
+
+def kernel_mode(rb) -> int:
+    """The integer mode the compiled kernels take for rulebook *rb* (chosen once per plan)."""
+    if rb.semantics.name == "goal-frame":
+        return GOAL_FRAME
+    return BOUNDS_RELATIVE if rb.bounds_mode == "relative" else BOUNDS_ABSOLUTE
+
+
+def kernel_for(mode: int):
+    """The compiled loop for *mode*: the paper's Algorithm 1 or its goal-frame variant."""
+    if mode == GOAL_FRAME:
+        from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
+
+        return goal_frame_kernel
+    return fuzzy_rrt_kernel
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -82,6 +100,32 @@ def _interval(lo_raw, hi_raw, offset, limit_lo, limit_hi):
             lo = limit_lo
             hi = limit_lo
     return lo, hi
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def record_iteration(row, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample, tr_nearest,
+                     tr_new, tr_outcome, tr_node, tr_tree, from_node, x, y, box_lo0, box_hi0,
+                     box_lo1, box_hi1, goal_sampled, sx, sy, nearest_node, q_new, outcome,
+                     new_index, tree_size):
+    """Write trace row *row* (shared by every Fuzzy-RRT kernel, so traces mean one thing)."""
+    tr_from[row] = from_node
+    for k in range(x.shape[0]):
+        tr_x[row, k] = x[k]
+    for k in range(y.shape[0]):
+        tr_y[row, k] = y[k]
+    tr_box[row, 0] = box_lo0
+    tr_box[row, 1] = box_hi0
+    tr_box[row, 2] = box_lo1
+    tr_box[row, 3] = box_hi1
+    tr_goal_sampled[row] = goal_sampled
+    tr_sample[row, 0] = sx
+    tr_sample[row, 1] = sy
+    tr_nearest[row] = nearest_node
+    tr_new[row, 0] = q_new[0]
+    tr_new[row, 1] = q_new[1]
+    tr_outcome[row] = outcome
+    tr_node[row] = new_index
+    tr_tree[row] = tree_size
 
 
 @nb.njit(cache=True, nogil=True)
@@ -152,26 +196,10 @@ def fuzzy_rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, 
                                     nodes, parent, cell_next, cell_head, meta, grid, current,
                                     sx, sy, step, q_near, q_new)
         if record:
-            tr_from[row] = from_node
-            tr_x[row, 0] = x[0]
-            tr_x[row, 1] = x[1]
-            tr_x[row, 2] = x[2]
-            tr_x[row, 3] = x[3]
-            for k in range(N_OUTPUTS):
-                tr_y[row, k] = y[k]
-            tr_box[row, 0] = lo0
-            tr_box[row, 1] = hi0
-            tr_box[row, 2] = lo1
-            tr_box[row, 3] = hi1
-            tr_goal_sampled[row] = goal_sampled
-            tr_sample[row, 0] = sx
-            tr_sample[row, 1] = sy
-            tr_nearest[row] = current
-            tr_new[row, 0] = q_new[0]
-            tr_new[row, 1] = q_new[1]
-            tr_outcome[row] = outcome
-            tr_node[row] = new_index
-            tr_tree[row] = meta[0]
+            record_iteration(row, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample,
+                             tr_nearest, tr_new, tr_outcome, tr_node, tr_tree, from_node, x, y,
+                             lo0, hi0, lo1, hi1, goal_sampled, sx, sy, current, q_new, outcome,
+                             new_index, meta[0])
         if outcome == GOAL_REACHED:
             return True, it, new_index
     return False, max_iter, -1
@@ -226,12 +254,13 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     check_max_iter(max_iter)
     rb = _resolve_rulebook(rulebook)
     knots, consts = rb.compiled
-    mode = BOUNDS_RELATIVE if rb.bounds_mode == "relative" else BOUNDS_ABSOLUTE
+    mode = kernel_mode(rb)
+    kernel = kernel_for(mode)
     a = scenario.arrays()
     tree = Tree(int(max_iter) + 2, a.limits_deg)
     buffers = _TraceBuffers(int(max_iter) if trace else 1)
     t0 = time.perf_counter()
-    ok, iterations, last = fuzzy_rrt_kernel(
+    ok, iterations, last = kernel(
         a.links, a.base, a.link_radius, a.obstacles, a.limits_deg, a.start_deg, a.goal_deg,
         int(seed), int(max_iter), knots, consts, mode, float(min_step_deg), float(margin),
         tree.nodes, tree.parent, tree.cell_next, tree.cell_head, tree.meta, tree.grid,
@@ -247,7 +276,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
         rulebook=rb.name, rulebook_sha256=rb.sha256,
-        params={"max_iter": int(max_iter), "bounds": rb.bounds_mode,
+        params={"max_iter": int(max_iter), "semantics": rb.semantics.name, "bounds": rb.bounds_mode,
                 "min_step_deg": float(min_step_deg), "margin_m": float(margin)},
     )
     if trace:

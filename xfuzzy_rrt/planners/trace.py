@@ -15,6 +15,8 @@ One row per iteration (``iteration`` = 1..iterations). Columns, in this order:
 - ``goal_sampled``, ``outcome`` (accepted, node_in_collision, edge_blocked, goal_reached,
   no_progress), ``on_path`` (the node added at this iteration lies on the returned path),
   ``rulebook``, ``rulebook_sha256`` (which rulebook made these decisions);
+- with a rulebook of another semantics (e.g. ``goal-frame``) the input and output columns carry
+  that semantics' names instead, and the box is the bounding box of its sampling region;
 - per FIS ``<output>_rule_<k>`` for k = 0..15, then per FIS ``<output>_strength_<k>``: the
   rules that fired (index into the rulebook's 625, ascending; -1 for unused slots) and their
   normalised strengths (summing to 1).
@@ -27,7 +29,7 @@ import functools
 import numpy as np
 import pandas as pd
 
-from xfuzzy_rrt.fuzzy.variables import INPUTS, MAX_FIRED, OUTPUTS
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.planners.result import OUTCOME_NAMES
 
 
@@ -41,15 +43,19 @@ def _columns(names: list[str]) -> pd.Index:
     return pd.Index(names, dtype=object)
 
 
-_RULE_NAMES = [c for out in OUTPUTS for c in fired_columns(out)[0]]
-_STRENGTH_NAMES = [c for out in OUTPUTS for c in fired_columns(out)[1]]
 _OUTCOME_DTYPE = pd.CategoricalDtype([OUTCOME_NAMES[k] for k in sorted(OUTCOME_NAMES)])
 _INT_HEAD = _columns(["iteration", "from_node", "nearest_node", "new_node", "tree_size"])
-_FLOAT_HEAD = _columns(["from_q1_deg", "from_q2_deg", *INPUTS, *OUTPUTS, "box_q1_lo",
-                        "box_q1_hi", "box_q2_lo", "box_q2_hi", "step_used_deg", "sample_q1_deg",
-                        "sample_q2_deg", "new_q1_deg", "new_q2_deg"])
-_RULES = _columns(_RULE_NAMES)
-_STRENGTHS = _columns(_STRENGTH_NAMES)
+
+
+@functools.lru_cache(maxsize=8)
+def _column_blocks(inputs: tuple[str, ...], outputs: tuple[str, ...]):
+    """Precomputed column indexes of one semantics (float head, rule and strength blocks)."""
+    float_head = _columns(["from_q1_deg", "from_q2_deg", *inputs, *outputs, "box_q1_lo",
+                           "box_q1_hi", "box_q2_lo", "box_q2_hi", "step_used_deg",
+                           "sample_q1_deg", "sample_q2_deg", "new_q1_deg", "new_q2_deg"])
+    rules = _columns([c for out in outputs for c in fired_columns(out)[0]])
+    strengths = _columns([c for out in outputs for c in fired_columns(out)[1]])
+    return float_head, rules, strengths
 
 
 @functools.lru_cache(maxsize=64)
@@ -81,7 +87,7 @@ def trace_frame(buffers, iterations: int, nodes: np.ndarray, parent: np.ndarray,
                          new_node, buffers.tree[:n]], axis=1)
     float_head = np.concatenate([
         nodes[from_node], buffers.x[:n], buffers.y[:n], buffers.box[:n],
-        np.maximum(buffers.y[:n, OUTPUTS.index("step_size")], min_step_deg)[:, None],
+        np.maximum(buffers.y[:n, -1], min_step_deg)[:, None],  # the step is the last output
         buffers.sample[:n], buffers.new[:n],
     ], axis=1)
     zeros = np.zeros(n, dtype=np.int8)
@@ -95,10 +101,11 @@ def trace_frame(buffers, iterations: int, nodes: np.ndarray, parent: np.ndarray,
         "rulebook_sha256": pd.Categorical.from_codes(
             zeros, dtype=_constant_dtype(rulebook.sha256), validate=False),
     })
+    float_cols, rule_cols, strength_cols = _column_blocks(rulebook.inputs, rulebook.outputs)
     return pd.concat([
         pd.DataFrame(int_head, columns=_INT_HEAD, copy=False),
-        pd.DataFrame(float_head, columns=_FLOAT_HEAD, copy=False),
+        pd.DataFrame(float_head, columns=float_cols, copy=False),
         extras,
-        pd.DataFrame(buffers.rule[:n].reshape(n, -1).astype(np.int64), columns=_RULES, copy=False),
-        pd.DataFrame(buffers.w[:n].reshape(n, -1), columns=_STRENGTHS, copy=False),
+        pd.DataFrame(buffers.rule[:n].reshape(n, -1).astype(np.int64), columns=rule_cols, copy=False),
+        pd.DataFrame(buffers.w[:n].reshape(n, -1), columns=strength_cols, copy=False),
     ], axis=1)

@@ -289,6 +289,23 @@ def _ratio_plot(ctx, runs: pd.DataFrame) -> str:
             "scenario.</p>" + ratio_svg(panels) + "</div>")
 
 
+def worst_per_planner(result) -> dict[str, Any]:
+    """Per planner, the stored run that came closest to an obstacle (or went deepest into one)
+    over all scenarios: the smallest ``min_clearance_m`` among the bench's worst examples (one
+    per scenario and planner); the first scenario on ties."""
+    out: dict[str, Any] = {}
+    key: dict[str, float] = {}
+    order = {n: i for i, n in enumerate(result.scenarios)}
+    items = sorted((getattr(result, "worst_examples", None) or {}).items(),
+                   key=lambda kv: (order.get(kv[0][0], 1 << 30), kv[0][1]))
+    for (_, planner), run in items:
+        c = run.min_clearance_m
+        c = float(c) if c is not None and np.isfinite(c) else float("inf")
+        if planner not in out or c < key[planner]:
+            out[planner], key[planner] = run, c
+    return out
+
+
 def worst_pose(scenario, path_deg: np.ndarray) -> tuple[np.ndarray, float]:
     """The configuration along ``path_deg`` (sampled every 0.25°) with the smallest signed
     clearance, and that clearance in metres (negative: penetration)."""
@@ -325,15 +342,15 @@ def _certification(ctx, page: Page, t: pd.DataFrame) -> None:
         "green and pink: the arm at start and goal; pale: the arm along the path; line: the "
         "end-effector trace; red: the arm at its closest configuration. OMPL checks motions by "
         "sampling, so its paths may graze obstacles between samples.")
-    worst = dict(getattr(result, "worst", None) or {})
+    worst = worst_per_planner(result)
     cells = []
     for p in ctx["planners"]:
         r = worst.get(p)
         s = result.scenarios.get(r.scenario) if r is not None else None
         if r is None or s is None or s.arm.dof != 2 or np.size(r.path_deg) < 4:
             cells.append(f'<div class="cell"><p class="muted">{esc(F.planner_label(p))}: no '
-                         "stored worst path (a bench folder written before they were stored "
-                         "or no path found)</p></div>")
+                         "stored worst path (no path found, or a bench folder written before "
+                         "worst paths were stored)</p></div>")
             continue
         fig = worst_path_figure(s, r)
         link = Names.from_entry(ctx["names"].scen[r.scenario]) \

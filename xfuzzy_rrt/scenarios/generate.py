@@ -48,7 +48,16 @@ class GeneratedProblem:
     c_obstacle_fraction: float
 
 
-def _draw(rng: np.random.Generator, name: str) -> Scenario:
+#: Problem families: the shared ``sample-*`` family and two harder ones that cover what users
+#: meet beyond it (training on a mixture is what lets a rulebook transfer; see rulebooks/README).
+FAMILIES = ("sample", "hard", "mira")
+
+
+def _draw(rng: np.random.Generator, name: str, family: str = "sample") -> Scenario:
+    if family == "hard":
+        return _draw_hard(rng, name)
+    if family == "mira":
+        return _draw_mira(rng, name)
     l1 = round(float(rng.uniform(0.14, 0.20)), 3)
     l2 = round(float(rng.uniform(0.09, 0.15)), 3)
     q = rng.integers(-170, 171, size=4).astype(float)
@@ -67,6 +76,63 @@ def _draw(rng: np.random.Generator, name: str) -> Scenario:
     arm = Arm(links=(l1, l2), base=(0.0, 0.0), link_radius=0.005,
               joint_limits_deg=((-180.0, 180.0), (-180.0, 180.0)))
     return Scenario(name=name, arm=arm, start_deg=(q[0], q[1]), goal_deg=(q[2], q[3]),
+                    obstacles=tuple(obstacles))
+
+
+def _box(cx: float, cy: float, w: float, h: float) -> Box:
+    x0, y0 = round(cx - w / 2, 4), round(cy - h / 2, 4)
+    return Box(min=(x0, y0), max=(round(x0 + w, 4), round(y0 + h, 4)))
+
+
+def _arm(l1: float, l2: float) -> Arm:
+    return Arm(links=(round(l1, 3), round(l2, 3)), base=(0.0, 0.0), link_radius=0.005,
+               joint_limits_deg=((-180.0, 180.0), (-180.0, 180.0)))
+
+
+def _draw_hard(rng: np.random.Generator, name: str) -> Scenario:
+    """Cluttered: the sample family's arm among 6-10 obstacles, a third of them thin walls
+    (1-2 cm by 6-14 cm, any orientation of the two axes) that cut narrow passages and traps."""
+    l1, l2 = rng.uniform(0.14, 0.20), rng.uniform(0.09, 0.15)
+    q = rng.integers(-170, 171, size=4).astype(float)
+    obstacles = []
+    for _ in range(int(rng.integers(6, 11))):
+        r = rng.uniform(0.10, 0.34)
+        a = rng.uniform(0.0, 2.0 * math.pi)
+        cx, cy = r * math.cos(a), r * math.sin(a)
+        u = rng.random()
+        if u < 0.35:
+            t, length = rng.uniform(0.01, 0.02), rng.uniform(0.06, 0.14)
+            obstacles.append(_box(cx, cy, t, length) if rng.random() < 0.5 else _box(cx, cy, length, t))
+        elif u < 0.8:
+            obstacles.append(Circle(center=(round(cx, 4), round(cy, 4)),
+                                    radius=round(float(rng.uniform(0.02, 0.05)), 4)))
+        else:
+            w, h = rng.uniform(0.03, 0.07, size=2)
+            obstacles.append(_box(cx, cy, w, h))
+    return Scenario(name=name, arm=_arm(l1, l2), start_deg=(q[0], q[1]), goal_deg=(q[2], q[3]),
+                    obstacles=tuple(obstacles))
+
+
+def _draw_mira(rng: np.random.Generator, name: str) -> Scenario:
+    """MIRA-like (the shipped ``demo-*`` setting): two similar links of 0.13-0.17 m, a pair of
+    organs (circles of 3-5 cm) held 10-16 cm apart, which the forearm must thread or avoid,
+    plus 1-3 retractor boxes."""
+    l1, l2 = rng.uniform(0.14, 0.17), rng.uniform(0.12, 0.16)
+    q = rng.integers(-170, 171, size=4).astype(float)
+    a = rng.uniform(0.0, 2.0 * math.pi)
+    r = rng.uniform(0.20, 0.27)
+    gap = rng.uniform(0.10, 0.16) / 2
+    cx, cy = r * math.cos(a), r * math.sin(a)
+    nx, ny = -math.sin(a), math.cos(a)
+    radius = float(rng.uniform(0.03, 0.05))
+    obstacles = [Circle(center=(round(cx + s * gap * nx, 4), round(cy + s * gap * ny, 4)),
+                        radius=round(radius, 4)) for s in (-1.0, 1.0)]
+    for _ in range(int(rng.integers(1, 4))):
+        rb = rng.uniform(0.15, 0.30)
+        ab = rng.uniform(0.0, 2.0 * math.pi)
+        w, h = rng.uniform(0.02, 0.07, size=2)
+        obstacles.append(_box(rb * math.cos(ab), rb * math.sin(ab), w, h))
+    return Scenario(name=name, arm=_arm(l1, l2), start_deg=(q[0], q[1]), goal_deg=(q[2], q[3]),
                     obstacles=tuple(obstacles))
 
 
@@ -143,8 +209,15 @@ def scenario_toml(s: Scenario, description: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def generate_one(seed: int, k: int, prefix: str = "gen") -> GeneratedProblem:
-    """Problem ``k`` of generator ``seed`` (draws until one passes every check)."""
+def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample") -> GeneratedProblem:
+    """Problem ``k`` of generator ``seed`` in *family* (draws until one passes every check).
+
+    The ``sample`` family draws from ``default_rng([seed, k])`` (as it always has); the other
+    families from ``default_rng([seed, k, i])`` with ``i`` their index in :data:`FAMILIES`, so
+    no two families share a stream.
+    """
+    if family not in FAMILIES:
+        raise ValueError(f"unknown family {family!r} (known: {', '.join(FAMILIES)})")
     from xfuzzy_rrt.errors import ScenarioError
     from xfuzzy_rrt.geometry.collision import config_free, segment_free
     from xfuzzy_rrt.geometry.scenario import scenario_from_dict
@@ -152,10 +225,11 @@ def generate_one(seed: int, k: int, prefix: str = "gen") -> GeneratedProblem:
 
     import tomllib
 
-    rng = np.random.default_rng([int(seed), int(k)])
+    index = FAMILIES.index(family)
+    rng = np.random.default_rng([int(seed), int(k)] if index == 0 else [int(seed), int(k), index])
     name = f"{prefix}-{seed}-{k:03d}"
     for _ in range(MAX_DRAWS_PER_PROBLEM):
-        draft = _draw(rng, name)
+        draft = _draw(rng, name, family)
         try:
             s = scenario_from_dict(tomllib.loads(scenario_toml(draft, "draft")), name)
         except ScenarioError:
@@ -175,8 +249,12 @@ def generate_one(seed: int, k: int, prefix: str = "gen") -> GeneratedProblem:
         straight = float(np.linalg.norm(a.goal_deg - a.start_deg))
         optimal = grid_optimal_deg(s, grid=grid)
         fraction = float(1.0 - free.mean())
-        desc = (f"generated (xfuzzy-rrt scenarios generate, seed {seed}, problem {k}); "
-                f"grid-optimal {optimal:.1f} deg, straight {straight:.1f} deg, "
+        # a passage narrower than the 2 deg grid can hide the solution RRT just proved exists
+        grid_text = (f"grid-optimal {optimal:.1f} deg" if math.isfinite(optimal)
+                     else f"no grid path at {GRID_DEG:g} deg (passages narrower than the grid)")
+        family_text = "" if family == "sample" else f", family {family}"
+        desc = (f"generated (xfuzzy-rrt scenarios generate, seed {seed}, problem {k}{family_text}); "
+                f"{grid_text}, straight {straight:.1f} deg, "
                 f"C-obstacle fraction {fraction:.3f}")
         text = scenario_toml(s, desc)
         final = scenario_from_dict(tomllib.loads(text), name)
@@ -185,6 +263,6 @@ def generate_one(seed: int, k: int, prefix: str = "gen") -> GeneratedProblem:
     raise RuntimeError(f"no valid problem after {MAX_DRAWS_PER_PROBLEM} draws (seed {seed}, k {k})")
 
 
-def generate(count: int, seed: int, prefix: str = "gen") -> list[GeneratedProblem]:
-    """``count`` valid, solvable, non-trivial problems, determined by ``seed``."""
-    return [generate_one(seed, k, prefix) for k in range(count)]
+def generate(count: int, seed: int, prefix: str = "gen", family: str = "sample") -> list[GeneratedProblem]:
+    """``count`` valid, solvable, non-trivial problems, determined by ``seed`` and *family*."""
+    return [generate_one(seed, k, prefix, family) for k in range(count)]

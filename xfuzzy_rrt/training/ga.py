@@ -25,8 +25,9 @@ Initialisation (``init="seeded"``, the default): a population of uniformly rando
 flat — measured on ``paper-reference``, random rule constants average out to a tiny sampling
 box and fail every run, so every individual scores -100 and selection has nothing to select.
 So the first generation holds rulebooks that already solve problems — the RRT-equivalent one
-(full box, bias 0.05, step 10°), goal-biased variants of it, the ``expert`` rulebook when its
-bounds meaning matches — and perturbations of them at several scales: small per-rule noise and
+(full box, bias 0.05, step 10°), goal-biased variants of it, the seed rulebooks (``train
+--seed-rulebook``; by default the shipped ``expert`` when its bounds meaning matches), whose
+SHA-256 are part of the configuration — and perturbations of them at several scales: small per-rule noise and
 whole-output shifts (which move a bound or the bias everywhere at once, the coarse direction a
 per-rule mutation cannot take). ``init="random"`` gives the paper-style uniform start for
 comparison.
@@ -43,17 +44,20 @@ from typing import Callable
 import numpy as np
 
 from xfuzzy_rrt.fuzzy.variables import N_OUTPUTS, N_RULES
-from xfuzzy_rrt.training.evaluate import fitness as mean_reward
+from xfuzzy_rrt.training.evaluate import FITNESSES, score
 from xfuzzy_rrt.training.genome import (
     GENES_PER_FIS,
     MF_GENES,
+    MODES,
     N_GENES,
     constant_genome,
+    constant_outputs_genome,
     encode,
 )
 
 HISTORY_COLUMNS = ["generation", "best_fitness", "mean_fitness", "median_fitness", "wall_s",
-                   "best_median_iterations", "success_rate", "runs", "runs_per_s"]
+                   "best_median_iterations", "success_rate", "runs", "runs_per_s",
+                   "validation_fitness"]
 
 
 @dataclass(frozen=True)
@@ -78,6 +82,13 @@ class GAConfig:
     init: str = "seeded"
     validation_runs: int = 50
     scenarios: tuple[tuple[str, str], ...] = ()  # (name, sha256) of each training scenario
+    fitness: str = "paper"  # or "log-ratio" (see .evaluate.log_ratio_fitness)
+    baseline: tuple[float, ...] = ()  # RRT median iterations per training scenario (log-ratio)
+    validation: tuple[tuple[str, str], ...] = ()  # held-out scenarios that pick the final rulebook
+    validation_baseline: tuple[float, ...] = ()
+    #: (name, sha256) of each seed rulebook of a seeded first generation, in order: the first
+    #: generation depends on them, so they are part of the fingerprint and of the provenance.
+    seed_rulebooks: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         from xfuzzy_rrt.errors import InputError
@@ -91,7 +102,13 @@ class GAConfig:
         need(1 <= self.runs_per_eval <= 10_000, "--runs-per-eval", f"must lie in [1, 10000], got {self.runs_per_eval}")
         need(np.isfinite(self.target_fitness), "--target-fitness", "must be a finite number")
         need(0 <= self.seed < 2**63, "--seed", f"must lie in [0, 2^63), got {self.seed}")
-        need(self.bounds in ("absolute", "relative"), "--bounds", f"must be absolute or relative, got {self.bounds!r}")
+        need(self.bounds in MODES, "--bounds", f"must be one of {', '.join(MODES)}, got {self.bounds!r}")
+        need(self.fitness in FITNESSES, "--fitness", f"must be one of {', '.join(FITNESSES)}, got {self.fitness!r}")
+        if self.fitness == "log-ratio":
+            need(len(self.baseline) == len(self.scenarios) and all(b > 0 for b in self.baseline),
+                 "--fitness", "log-ratio needs RRT's positive median iterations for every training scenario")
+            need(len(self.validation_baseline) == len(self.validation), "--validation-scenario",
+                 "log-ratio needs RRT's median iterations for every validation scenario")
         need(1 <= self.max_iter <= 1_000_000, "--max-iter", f"must lie in [1, 1000000], got {self.max_iter}")
         need(0 <= self.elite < self.population, "--elite", f"must lie in [0, population), got {self.elite}")
         need(2 <= self.tournament <= self.population, "--tournament", f"must lie in [2, population], got {self.tournament}")
@@ -101,15 +118,25 @@ class GAConfig:
         need(self.init in ("seeded", "random"), "--init", f"must be seeded or random, got {self.init!r}")
         need(0 <= self.validation_runs <= 10_000, "--validation-runs", "must lie in [0, 10000]")
         need(len(self.scenarios) >= 1, "--scenario", "give at least one training scenario")
+        need(self.init == "seeded" or not self.seed_rulebooks, "--seed-rulebook",
+             "seed rulebooks are only used with --init seeded")
 
     #: Options that only say when to stop or how to choose at the end: a checkpoint may be
     #: resumed with other values (e.g. more generations), and the result is then exactly that
     #: of a run asked for with those values from the start.
     STOPPING = ("generations", "target_fitness", "validation_runs")
+    #: Options added after the first checkpoints were written: left out of the fingerprint
+    #: while they keep their default, so older checkpoints still resume.
+    LATER = {"fitness": "paper", "baseline": (), "validation": (), "validation_baseline": (),
+             "seed_rulebooks": ()}
 
     def fingerprint(self) -> str:
-        """SHA-256 of the options that shape the search (identifies a checkpoint's run)."""
-        fields = {k: v for k, v in asdict(self).items() if k not in self.STOPPING}
+        """SHA-256 of the options that shape the search (identifies a checkpoint's run),
+        including the training scenarios' and the seed rulebooks' SHA-256. Options added later
+        are left out while they keep their default (absent rather than empty), so a run that
+        does not use them keeps the fingerprint it had before they existed and still resumes."""
+        fields = {k: v for k, v in asdict(self).items() if k not in self.STOPPING
+                  and not (k in self.LATER and v == self.LATER[k])}
         blob = json.dumps(fields, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()
 
@@ -132,8 +159,29 @@ def validation_seeds(seed: int, runs: int) -> np.ndarray:
 # ------------------------------------------------------------------------------ initial population
 
 
-def seed_genomes(bounds: str, expert=None) -> list[tuple[str, np.ndarray]]:
-    """Named genomes that already solve problems (see the module docstring)."""
+#: Constant goal-frame rulebooks that already beat RRT on the generated family (measured on
+#: training problems only): (goal_bias, uniform_share, ahead, behind, side, step).
+GOAL_FRAME_SEEDS = (
+    (0.05, 1.0, 0.0, 0.0, 0.0, 10.0),  # plain RRT expressed in the goal-frame semantics
+    (0.3, 0.2, 60.0, 20.0, 45.0, 15.0),
+    (0.2, 0.3, 90.0, 30.0, 60.0, 15.0),
+    (0.2, 0.2, 120.0, 40.0, 90.0, 10.0),
+    (0.3, 0.5, 60.0, 20.0, 45.0, 20.0),
+)
+
+
+def seed_genomes(bounds: str, rulebooks=()) -> list[tuple[str, np.ndarray]]:
+    """Named genomes that already solve problems (see the module docstring): the built-in
+    constant ones, then each of ``rulebooks`` (which must mean what the training means:
+    the same bounds, or the goal-frame semantics)."""
+    if bounds == "goal-frame":
+        out = [(f"goal-frame-{i}", constant_outputs_genome(v, bounds))
+               for i, v in enumerate(GOAL_FRAME_SEEDS)]
+        for rb in rulebooks:
+            if rb.semantics.name != "goal-frame":
+                raise ValueError(f"seed rulebook {rb.name!r} is not a goal-frame rulebook")
+            out.append((rb.name, encode(*rb.arrays(), bounds)))
+        return out
     full = (-180.0, 180.0, -180.0, 180.0)
     out = [("rrt-equivalent", constant_genome(0.05, full, 10.0))]
     for bias in (0.1, 0.2, 0.35, 0.5):
@@ -141,18 +189,29 @@ def seed_genomes(bounds: str, expert=None) -> list[tuple[str, np.ndarray]]:
     if bounds == "relative":
         for half in (30.0, 60.0, 90.0):
             out.append((f"window-{half:g}", constant_genome(0.2, (-half, half, -half, half), 10.0)))
-    if expert is not None and expert.bounds_mode == bounds:
-        knots, consts = expert.arrays()
-        out.append((expert.name, encode(knots, consts)))
+    for rb in rulebooks:
+        if rb.semantics.name != "paper" or rb.bounds_mode != bounds:
+            raise ValueError(f"seed rulebook {rb.name!r} has {rb.bounds_mode} bounds, the "
+                             f"training {bounds}")
+        knots, consts = rb.arrays()
+        out.append((rb.name, encode(knots, consts)))
     return out
 
 
-def initial_population(config: GAConfig, rng: np.random.Generator, expert=None) -> np.ndarray:
-    """The first generation ``[population, 3822]`` (deterministic given ``rng``)."""
+def initial_population(config: GAConfig, rng: np.random.Generator, rulebooks=()) -> np.ndarray:
+    """The first generation ``[population, 3822]`` (deterministic given ``rng``).
+
+    ``rulebooks`` are the seed rulebooks; they must be exactly those ``config.seed_rulebooks``
+    names (same order, same SHA-256), so the population depends only on what is recorded.
+    """
     n = config.population
+    given = tuple((rb.name, rb.sha256) for rb in rulebooks)
+    if given != tuple(tuple(x) for x in config.seed_rulebooks):
+        raise ValueError(f"seed rulebooks {given} are not the configuration's "
+                         f"{config.seed_rulebooks}")
     if config.init == "random":
         return rng.random((n, N_GENES))
-    seeds = [g for _, g in seed_genomes(config.bounds, expert)]
+    seeds = [g for _, g in seed_genomes(config.bounds, rulebooks)]
     pop = np.empty((n, N_GENES))
     k = min(len(seeds), n)
     pop[:k] = np.array(seeds[:k])
@@ -272,9 +331,9 @@ class TrainResult:
     state: TrainState
 
 
-def new_state(config: GAConfig, expert=None) -> TrainState:
+def new_state(config: GAConfig, rulebooks=()) -> TrainState:
     rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([config.seed, 0])))
-    pop = initial_population(config, rng, expert)
+    pop = initial_population(config, rng, rulebooks)
     return TrainState(generation=0, population=pop, rng_state=rng.bit_generator.state)
 
 
@@ -283,11 +342,21 @@ class Trainer:
 
     def __init__(self, config: GAConfig, evaluator,
                  on_generation: Callable[[dict, TrainState], None] | None = None,
-                 on_chunk: Callable[[int, int], None] | None = None):
+                 on_chunk: Callable[[int, int], None] | None = None,
+                 validator=None):
+        """*validator* (optional) evaluates on the held-out ``config.validation`` scenarios:
+        each generation's best is scored there (the train / validation gap in the history),
+        and the final rulebook is chosen there instead of on fresh seeds of the training set."""
         self.config = config
         self.evaluator = evaluator
         self.on_generation = on_generation
         self.on_chunk = on_chunk
+        self.validator = validator
+
+    def _fitness(self, its: np.ndarray, held_out: bool = False) -> np.ndarray:
+        c = self.config
+        baseline = c.validation_baseline if held_out else c.baseline
+        return score(its, c.fitness, c.max_iter, np.asarray(baseline, dtype=np.float64))
 
     def step(self, state: TrainState) -> TrainState:
         """Evaluate ``state.population``, record, stop or breed; return the next state."""
@@ -295,10 +364,15 @@ class Trainer:
         t0 = time.perf_counter()
         seeds = generation_seeds(c.seed, state.generation, c.runs_per_eval)
         its = self.evaluator(state.population, seeds, self.on_chunk)
-        fit = mean_reward(its, c.max_iter)
+        fit = self._fitness(its)
         best = int(np.lexsort((np.arange(len(fit)), -fit))[0])
         ok = (its >= 0) & (its < c.max_iter)
         best_its = np.where(ok[best], its[best], c.max_iter)
+        held_out = float("nan")
+        if self.validator is not None:
+            # the same seeds every generation, so the curve compares like with like
+            v_its = self.validator(state.population[best][None], validation_seeds(c.seed, c.runs_per_eval))
+            held_out = float(self._fitness(v_its, held_out=True)[0])
         wall = time.perf_counter() - t0
         runs = int(its.size)
         row = {
@@ -311,6 +385,7 @@ class Trainer:
             "success_rate": float(ok.mean()),
             "runs": runs,
             "runs_per_s": runs / wall if wall > 0 else float("nan"),
+            "validation_fitness": held_out,
         }
         generation = state.generation + 1
         done = generation >= c.generations or fit[best] >= c.target_fitness
@@ -377,8 +452,12 @@ class Trainer:
                                validation_success_rate=float("nan"),
                                chosen_from=f"hall of fame, generation {last + 1}", state=state)
         seeds = validation_seeds(c.seed, c.validation_runs)
-        its = self.evaluator(genes, seeds, self.on_chunk)
-        fit = mean_reward(its, c.max_iter)
+        if self.validator is not None:
+            its = self.validator(genes, seeds, self.on_chunk)
+            fit = self._fitness(its, held_out=True)
+        else:
+            its = self.evaluator(genes, seeds, self.on_chunk)
+            fit = self._fitness(its)
         best = int(np.lexsort((np.arange(len(fit)), -fit))[0])
         ok = (its[best] >= 0) & (its[best] < c.max_iter)
         return TrainResult(

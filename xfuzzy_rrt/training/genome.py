@@ -1,6 +1,6 @@
 """The genome: how 3,822 genes become six fuzzy systems that are always valid.
 
-Layout (the paper's count): per FIS, in OUTPUTS order, 637 genes —
+Layout (the paper's count): per FIS, in the semantics' output order, 637 genes —
 ``4 inputs x 3`` membership genes, then the 625 rule constants in rule-index order — so an
 individual has ``6 x 637 = 3,822`` genes. Every gene lives in ``[0, 1]`` (the GA's bounds), and
 decoding maps it into the fuzzy system, so *whatever crossover and mutation do* (as long as
@@ -23,16 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from xfuzzy_rrt.fuzzy.variables import (
-    INPUT_RANGES,
-    INPUTS,
-    N_INPUTS,
-    N_OUTPUTS,
-    N_RULES,
-    N_TERMS,
-    OUTPUT_RANGES,
-    OUTPUTS,
-)
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.fuzzy.variables import N_INPUTS, N_OUTPUTS, N_RULES, N_TERMS
 
 #: Membership genes per input (the three interior peaks; the ends are the range ends).
 MF_GENES_PER_INPUT = N_TERMS - 2
@@ -42,10 +34,22 @@ N_GENES = N_OUTPUTS * GENES_PER_FIS  # 3,822
 A_MIN = 0.05
 A_MAX = 0.95
 
-_IN_LO = np.array([INPUT_RANGES[n][0] for n in INPUTS])
-_IN_HI = np.array([INPUT_RANGES[n][1] for n in INPUTS])
-_OUT_LO = np.array([OUTPUT_RANGES[n][0] for n in OUTPUTS])
-_OUT_HI = np.array([OUTPUT_RANGES[n][1] for n in OUTPUTS])
+#: The planner modes a genome can be trained for: the paper's semantics with absolute or
+#: relative bounds, or the goal-frame semantics (which has no bounds mode).
+MODES = ("absolute", "relative", "goal-frame")
+
+
+def semantics_of_mode(mode: str) -> "_sem.Semantics":
+    """The rulebook semantics a training mode produces."""
+    return _sem.GOAL_FRAME if mode == "goal-frame" else _sem.PAPER
+
+
+def _ranges(sem: "_sem.Semantics"):
+    """``(in_lo, in_hi, out_lo, out_hi)`` arrays of *sem* (inputs and outputs in order)."""
+    return (np.array([sem.input_ranges[n][0] for n in sem.inputs]),
+            np.array([sem.input_ranges[n][1] for n in sem.inputs]),
+            np.array([sem.output_ranges[n][0] for n in sem.outputs]),
+            np.array([sem.output_ranges[n][1] for n in sem.outputs]))
 
 
 def _split(genes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -55,18 +59,20 @@ def _split(genes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mf, g[:, :, MF_GENES:]
 
 
-def decode(genes) -> tuple[np.ndarray, np.ndarray]:
+def decode(genes, mode: str = "absolute") -> tuple[np.ndarray, np.ndarray]:
     """Engine arrays ``(knots [n, 6, 4, 5], consts [n, 6, 625])`` of a population ``[n, 3822]``.
 
     A single genome ``[3822]`` is accepted too (then ``n = 1``). Genes are clipped to [0, 1].
+    *mode* (one of :data:`MODES`) fixes the semantics, hence the input and output ranges.
     """
+    in_lo, in_hi, out_lo, out_hi = _ranges(semantics_of_mode(mode))
     genes = np.clip(np.atleast_2d(np.asarray(genes, dtype=np.float64)), 0.0, 1.0)
     if genes.shape[1] != N_GENES:
         raise ValueError(f"a genome has {N_GENES} genes, got {genes.shape[1]}")
     mf, c = _split(genes)
     a = A_MIN + (A_MAX - A_MIN) * mf
-    lo = np.broadcast_to(_IN_LO[None, None, :], a.shape[:3])
-    hi = np.broadcast_to(_IN_HI[None, None, :], a.shape[:3])
+    lo = np.broadcast_to(in_lo[None, None, :], a.shape[:3])
+    hi = np.broadcast_to(in_hi[None, None, :], a.shape[:3])
     knots = np.empty(a.shape[:3] + (N_TERMS,))
     knots[..., 0] = lo
     p1 = lo + a[..., 0] * (hi - lo)
@@ -76,11 +82,11 @@ def decode(genes) -> tuple[np.ndarray, np.ndarray]:
     knots[..., 2] = p2
     knots[..., 3] = p3
     knots[..., 4] = hi
-    consts = _OUT_LO[None, :, None] + c * (_OUT_HI - _OUT_LO)[None, :, None]
+    consts = out_lo[None, :, None] + c * (out_hi - out_lo)[None, :, None]
     return np.ascontiguousarray(knots), np.ascontiguousarray(consts)
 
 
-def encode(knots, consts) -> np.ndarray:
+def encode(knots, consts, mode: str = "absolute") -> np.ndarray:
     """Genome ``[3822]`` of engine arrays ``knots [6, 4, 5]``, ``consts [6, 625]``.
 
     Peaks whose fractions fall outside ``[A_MIN, A_MAX]`` (possible for hand-written rulebooks)
@@ -90,12 +96,13 @@ def encode(knots, consts) -> np.ndarray:
     consts = np.asarray(consts, dtype=np.float64)
     if knots.shape != (N_OUTPUTS, N_INPUTS, N_TERMS) or consts.shape != (N_OUTPUTS, N_RULES):
         raise ValueError("expected knots [6, 4, 5] and consts [6, 625]")
+    _, _, out_lo, out_hi = _ranges(semantics_of_mode(mode))
     lo = knots[..., 0]
     hi = knots[..., 4]
     p1, p2, p3 = knots[..., 1], knots[..., 2], knots[..., 3]
     a = np.stack([(p1 - lo) / (hi - lo), (p2 - p1) / (hi - p1), (p3 - p2) / (hi - p2)], axis=-1)
     mf = np.clip((a - A_MIN) / (A_MAX - A_MIN), 0.0, 1.0)
-    c = np.clip((consts - _OUT_LO[:, None]) / (_OUT_HI - _OUT_LO)[:, None], 0.0, 1.0)
+    c = np.clip((consts - out_lo[:, None]) / (out_hi - out_lo)[:, None], 0.0, 1.0)
     genome = np.empty((N_OUTPUTS, GENES_PER_FIS))
     genome[:, :MF_GENES] = mf.reshape(N_OUTPUTS, MF_GENES)
     genome[:, MF_GENES:] = c
@@ -109,9 +116,13 @@ def constant_genome(goal_bias: float, box: tuple[float, float, float, float],
     With ``box = (-180, 180, -180, 180)``, bias 0.05 and step 10 in absolute mode this is plain
     RRT with the baseline's settings (the "RRT-equivalent" rulebook).
     """
-    from xfuzzy_rrt.fuzzy.variables import default_knots
+    return constant_outputs_genome((goal_bias, *box, step), "absolute")
 
-    knots = np.array([[default_knots(n) for n in INPUTS]] * N_OUTPUTS)
-    values = (goal_bias, *box, step)
+
+def constant_outputs_genome(values, mode: str) -> np.ndarray:
+    """A genome whose six systems output the constants *values* (the semantics' output order),
+    with the default membership peaks of *mode*'s semantics."""
+    sem = semantics_of_mode(mode)
+    knots = np.array([[sem.default_knots(n) for n in sem.inputs]] * N_OUTPUTS)
     consts = np.array([[v] * N_RULES for v in values], dtype=np.float64)
-    return encode(knots, consts)
+    return encode(knots, consts, mode)

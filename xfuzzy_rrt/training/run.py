@@ -7,15 +7,18 @@ Output layout of ``--out DIR``::
     DIR/checkpoint/state.npz              the latest checkpoint (see .checkpoint)
 
 Everything in the rulebook — the six systems *and* the manifest — depends only on the training
-inputs (scenario files, options, ``--seed``), never on the worker count, the engine or an
-interruption: the manifest records a canonical command line rebuilt from the options (not the
-literal argv, which would differ with ``--workers`` or ``--resume``) and no wall-clock time.
+inputs (scenario files, seed rulebooks, options, ``--seed``), never on the worker count, the
+engine or an interruption: the manifest records a canonical command line rebuilt from the
+options (not the literal argv, which would differ with ``--workers`` or ``--resume``), the
+SHA-256 of every input file, the versions of the libraries the numbers depend on, and no
+wall-clock time.
 ``history.csv``'s ``wall_s`` and ``runs_per_s`` columns are the only measured (non-reproducible)
 numbers a training run writes.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import shlex
 from dataclasses import dataclass, field
@@ -27,7 +30,15 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.training.ga import HISTORY_COLUMNS, GAConfig, Trainer, TrainResult, new_state
 
 CHECKPOINT_DIR = "checkpoint"
+#: RRT runs per scenario (seeds 0..49) behind the log-ratio fitness's baseline.
+BASELINE_RUNS = 50
 HISTORY_FILE = "history.csv"
+#: The seed rulebook of ``--init seeded`` when no ``--seed-rulebook`` is given (shipped).
+DEFAULT_SEED_RULEBOOK = "expert"
+#: What a default seed rulebook is recorded as (``source``) in the manifest.
+PACKAGED = "packaged"
+#: Libraries whose versions a byte-exact rebuild of a trained rulebook depends on.
+VERSIONED = ("numpy", "numba", "pymoo", "scipy")
 
 
 @dataclass(frozen=True)
@@ -71,15 +82,83 @@ def load_training_scenarios(paths: list[Path]) -> list[TrainingScenario]:
     return items
 
 
-def canonical_command(config: GAConfig, scenario_args: list[str], out: str) -> str:
+@dataclass(frozen=True)
+class SeedRulebook:
+    """A rulebook the seeded first generation starts from, and where it came from."""
+
+    source: str  # the --seed-rulebook value as given, or PACKAGED for the default
+    rulebook: object
+
+    @property
+    def sha256(self) -> str:
+        return self.rulebook.sha256
+
+
+def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str) -> list[SeedRulebook]:
+    """The seed rulebooks of a training run, loaded and checked.
+
+    ``paths`` are the ``--seed-rulebook`` values (``None``: not given). Under ``--init
+    seeded`` the default is the shipped ``expert`` rulebook when it means its bounds as
+    ``bounds`` (none otherwise: the paper's absolute setting starts from the built-in genomes
+    alone); a missing default or a given seed that does not exist, does not load or has the
+    other bounds meaning is an error, never silently dropped (the first generation would
+    change under the same recorded command).
+    """
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
+
+    if init != "seeded":
+        if paths:
+            raise InputError("--seed-rulebook", "seed rulebooks are only used with --init seeded")
+        return []
+    if not paths:
+        folder = rulebooks_dir() / DEFAULT_SEED_RULEBOOK
+        if not folder.is_dir():
+            raise InputError(str(folder), f"the default seed rulebook {DEFAULT_SEED_RULEBOOK!r} "
+                             "is missing; pass --seed-rulebook DIR or --init random")
+        rb = load_rulebook(folder)
+        return [SeedRulebook(PACKAGED, rb)] if rb.bounds_mode == bounds else []
+    out = []
+    for p in paths:
+        rb = load_rulebook(p)  # a missing or broken folder is the usual one-line error
+        if bounds == "goal-frame":
+            if rb.semantics.name != "goal-frame":
+                raise InputError(str(p), "seed rulebook is not a goal-frame rulebook, but "
+                                 "--bounds is goal-frame")
+        elif rb.semantics.name != "paper" or rb.bounds_mode != bounds:
+            raise InputError(str(p), f"seed rulebook has {rb.bounds_mode} bounds, but "
+                             f"--bounds is {bounds}")
+        out.append(SeedRulebook(str(p), rb))
+    return out
+
+
+def library_versions() -> dict[str, str]:
+    """Python and the libraries whose versions the byte-exact result depends on."""
+    import platform
+    from importlib import metadata
+
+    out = {"python": platform.python_version()}
+    for dist in VERSIONED:
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            out[dist] = "not installed"
+    return out
+
+
+def canonical_command(config: GAConfig, scenario_args: list[str], out: str,
+                      seed_args: list[str] | None = None,
+                      validation_args: list[str] = ()) -> str:
     """The command that reproduces this training run (independent of workers and engine).
 
     ``scenario_args`` are the ``--scenario`` values as given (a folder stays a folder; the
-    manifest lists every file it held with its SHA-256).
+    manifest lists every file it held with its SHA-256); ``seed_args`` the ``--seed-rulebook``
+    values as given (none for the packaged default; the manifest records its SHA-256).
     """
     args = ["xfuzzy-rrt", "train"]
     for a in scenario_args:
         args += ["--scenario", a]
+    for a in seed_args or []:
+        args += ["--seed-rulebook", a]
     defaults = GAConfig(scenarios=(("x", "y"),))
     options = [("population", "--population"), ("generations", "--generations"),
                ("runs_per_eval", "--runs-per-eval"), ("target_fitness", "--target-fitness"),
@@ -88,14 +167,27 @@ def canonical_command(config: GAConfig, scenario_args: list[str], out: str) -> s
                ("crossover_prob", "--crossover-prob"), ("crossover_eta", "--crossover-eta"),
                ("mutation_rate", "--mutation-rate"), ("mutation_eta", "--mutation-eta"),
                ("block_rate", "--block-rate"), ("block_sigma", "--block-sigma"),
-               ("init", "--init"), ("validation_runs", "--validation-runs")]
+               ("init", "--init"), ("validation_runs", "--validation-runs"),
+               ("fitness", "--fitness")]
     always = {"population", "generations", "runs_per_eval", "target_fitness", "seed", "bounds"}
     for attr, flag in options:
         value = getattr(config, attr)
         if attr in always or value != getattr(defaults, attr):
             args += [flag, f"{value:g}" if isinstance(value, float) else str(value)]
+    for a in validation_args:
+        args += ["--validation-scenario", a]
     args += ["--out", out]
     return " ".join(shlex.quote(a) for a in args)
+
+
+def baselines(scenarios: list[TrainingScenario], max_iter: int) -> tuple[float, ...]:
+    """RRT's median iterations on each scenario over seeds ``0..BASELINE_RUNS-1``."""
+    import numpy as np
+
+    from xfuzzy_rrt.training.evaluate import Problem, rrt_baseline
+
+    problems = [Problem.from_scenario(t.scenario) for t in scenarios]
+    return tuple(float(b) for b in rrt_baseline(problems, np.arange(BASELINE_RUNS), max_iter))
 
 
 def history_frame(history: list[dict]):
@@ -119,6 +211,10 @@ class TrainJob:
     scenarios: list[TrainingScenario]
     out: Path
     scenario_args: list[str] = field(default_factory=list)  # --scenario values as given
+    validation: list[TrainingScenario] = field(default_factory=list)  # held-out scenarios
+    validation_args: list[str] = field(default_factory=list)
+    #: the seed rulebooks (see resolve_seed_rulebooks); must match config.seed_rulebooks
+    seed_rulebooks: list[SeedRulebook] = field(default_factory=list)
     resume: bool = False
     workers: int | None = None
     scheduler: str | None = None
@@ -130,9 +226,11 @@ class TrainJob:
         return self.out / CHECKPOINT_DIR
 
     def check_out(self) -> None:
-        """Refuse to clobber another run: an existing checkpoint needs ``--resume``."""
+        """Refuse bad engine options and clobbering another run (a checkpoint needs --resume)."""
         from xfuzzy_rrt.training.checkpoint import checkpoint_file
 
+        if self.workers is not None and self.workers < 1:
+            raise InputError("--workers", f"must be >= 1, got {self.workers}")
         if self.out.exists() and not self.out.is_dir():
             raise InputError(str(self.out), "exists and is not a directory")
         has = checkpoint_file(self.checkpoint_dir).exists()
@@ -147,7 +245,6 @@ def run_training(job: TrainJob,
                  on_chunk: Callable[[int, int], None] | None = None,
                  on_phase: Callable[[str], None] | None = None) -> TrainResult:
     """Train (or resume), checkpointing every generation; write the rulebook at the end."""
-    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
     from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
     from xfuzzy_rrt.training.evaluate import Problem
     from xfuzzy_rrt.training.workers import make_evaluator
@@ -157,14 +254,9 @@ def run_training(job: TrainJob,
     if job.resume:
         state = load_checkpoint(job.checkpoint_dir, config)
     else:
-        expert = None
-        expert_dir = rulebooks_dir() / "expert"
-        if config.init == "seeded" and expert_dir.is_dir():
-            expert = load_rulebook(expert_dir)
-        state = new_state(config, expert)
+        state = new_state(config, [s.rulebook for s in job.seed_rulebooks])
     problems = [Problem.from_scenario(t.scenario) for t in job.scenarios]
-    job.out.mkdir(parents=True, exist_ok=True)
-    _remove_stale_temporaries(job)
+    held_out = [Problem.from_scenario(t.scenario) for t in job.validation]
     history_path = job.out / HISTORY_FILE
 
     def checkpoint(row: dict, new) -> None:
@@ -173,17 +265,29 @@ def run_training(job: TrainJob,
         if on_generation:
             on_generation(row)
 
-    with make_evaluator(problems, config.bounds, config.max_iter, job.workers,
-                        job.scheduler) as evaluator:
+    # the engines first: a bad --scheduler or --workers fails before any folder is made
+    with contextlib.ExitStack() as stack:
+        evaluator = stack.enter_context(make_evaluator(problems, config.bounds, config.max_iter,
+                                                       job.workers, job.scheduler))
+        validator = None
+        if held_out:
+            validator = stack.enter_context(make_evaluator(held_out, config.bounds,
+                                                           config.max_iter, job.workers,
+                                                           job.scheduler))
+        job.out.mkdir(parents=True, exist_ok=True)
+        _remove_stale_temporaries(job)
         if on_start:
             on_start(evaluator.description, state.generation)
         if state.history:
             write_history(history_path, state.history)
-        trainer = Trainer(config, evaluator, on_generation=checkpoint, on_chunk=on_chunk)
+        trainer = Trainer(config, evaluator, on_generation=checkpoint, on_chunk=on_chunk,
+                          validator=validator)
         state = trainer.run(state)
         if on_phase:
-            on_phase(f"choosing the rulebook: {config.validation_runs} validation runs per "
-                     f"scenario for each generation's best")
+            where = (f"{len(held_out)} held-out validation scenarios" if held_out
+                     else "the training scenarios (fresh seeds)")
+            on_phase(f"choosing the rulebook: {config.validation_runs} runs per scenario on "
+                     f"{where} for each generation's best and the final top 5")
         result = trainer.choose(state)
     write_trained_rulebook(job, result)
     return result
@@ -204,13 +308,17 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
     from xfuzzy_rrt.training.genome import decode
 
     c = job.config
-    knots, consts = decode(result.genes)
+    from xfuzzy_rrt.training.genome import semantics_of_mode
+
+    knots, consts = decode(result.genes, c.bounds)
     history = result.state.history
     name = job.name or job.out.name or "trained"
+    sem = semantics_of_mode(c.bounds)
     provenance = {
         "kind": "ga",
         "command": canonical_command(c, job.scenario_args or [t.path for t in job.scenarios],
-                                     str(job.out)),
+                                     str(job.out), [s.source for s in job.seed_rulebooks
+                                                    if s.source != PACKAGED], job.validation_args),
         "algorithm": "generational GA: tournament selection, SBX crossover, polynomial and "
                      "term-block mutation, elitism (xfuzzy_rrt.training)",
         "package_version": __version__,
@@ -230,16 +338,33 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
         "validation_median_iterations": result.validation_iterations_median,
         "validation_success_rate": result.validation_success_rate,
         "history": HISTORY_FILE,
+        "fitness": c.fitness,
         "scenarios": [{"name": t.scenario.name, "file": t.path, "sha256": t.sha256}
                       for t in job.scenarios],
+        "seed_rulebooks": [{"name": s.rulebook.name, "source": s.source, "sha256": s.sha256}
+                           for s in job.seed_rulebooks],
+        "versions": library_versions(),
         **job.extra_provenance,
     }
-    description = (f"Trained by the genetic algorithm ({c.bounds} bounds) on "
+    if c.fitness == "log-ratio":
+        provenance["baseline"] = ("RRT median iterations per training scenario (seeds 0.."
+                                  f"{BASELINE_RUNS - 1}, step 10 deg, goal bias 0.05)")
+        provenance["baseline_iterations"] = [float(b) for b in c.baseline]
+    if job.validation:
+        provenance["validation_fitness_history"] = [float(r["validation_fitness"]) for r in history]
+        provenance["validation_scenarios"] = [
+            {"name": t.scenario.name, "file": t.path, "sha256": t.sha256} for t in job.validation]
+        if c.fitness == "log-ratio":
+            provenance["validation_baseline_iterations"] = [float(b) for b in c.validation_baseline]
+    what = "goal-frame semantics" if sem.name == "goal-frame" else f"{c.bounds} bounds"
+    description = (f"Trained by the genetic algorithm ({what}, {c.fitness} fitness) on "
                    f"{len(job.scenarios)} scenario(s); see [provenance].")
-    rb = Rulebook.from_arrays(knots[0], consts[0], name=name, bounds_mode=c.bounds,
-                              provenance=provenance, description=description)
+    rb = Rulebook.from_arrays(knots[0], consts[0], name=name,
+                              bounds_mode=None if sem.name == "goal-frame" else c.bounds,
+                              provenance=provenance, description=description, semantics=sem)
     return save_rulebook(rb, job.out)
 
 
-__all__ = ["TrainJob", "TrainingScenario", "canonical_command", "expand_scenarios",
-           "history_frame", "load_training_scenarios", "run_training"]
+__all__ = ["SeedRulebook", "TrainJob", "TrainingScenario", "canonical_command",
+           "expand_scenarios", "history_frame", "library_versions", "load_training_scenarios",
+           "resolve_seed_rulebooks", "run_training"]

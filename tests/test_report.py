@@ -360,6 +360,8 @@ def test_verdict_compares_ompl_on_time_to_first_path_and_reports_penetration():
     assert "certified success 67%" in text[1]
     assert "1 of 3 paths penetrated an obstacle (deepest 7.4 mm)" in text[1]
     assert text[2].startswith("RRT (the baseline)")
+    even = planner_table(runs.assign(iterations=100, time_first_s=0.01))
+    assert verdicts(even)[0].startswith("Fuzzy-RRT general needs as many iterations as RRT")
 
 
 # -------------------------------------------------------------------------------- numbers

@@ -177,7 +177,10 @@ def verdict(row, baseline_label: str = "RRT") -> str:
             parts.append(f"{row['label']} cannot be compared with {baseline_label} "
                          "(no scenario where both have a median)")
         else:
-            if row["metric"] == "iterations":
+            if _x(med if med >= 1 else 1 / med) == _x(1.0):  # "1× fewer" would say nothing
+                lead = (f"{row['label']} needs as many iterations as" if row["metric"] ==
+                        "iterations" else f"{row['label']} finds its first path as fast as")
+            elif row["metric"] == "iterations":
                 what = ("fewer iterations than" if med >= 1 else "more iterations than")
                 lead = f"{row['label']} needs {_x(med if med >= 1 else 1 / med)} {what}"
             else:

@@ -1,9 +1,15 @@
-"""The audit report in a real browser: every plot drawn, no error, no network, not blank.
+"""The audit report in a real browser, at the size the issue asks for: 24 generated scenarios
+× 4 planners (RRT, two rulebooks side by side, one OMPL planner), two runs each.
 
 A report that passes string checks can still fail where it matters -- in the reader's browser
-(a JavaScript error, a figure plotly cannot draw, a resource fetched from the network). So a
-generated report is opened from ``file://`` in headless Chromium (Debian's ``chromium``, driven
-by Playwright) and checked the way a reader would see it, the drill-down slider included.
+(a JavaScript error, a figure plotly cannot draw, a resource fetched from the network, a link
+to nowhere, an answer below the fold). So the generated site is opened from ``file://`` in
+headless Chromium (Debian's ``chromium``, driven by Playwright) and checked the way a reader
+would meet it: the overview's first screen (1400 × 900) shows the verdict and the ratio plot and
+responds within 2 s, every figure on every page has drawn marks, nothing is requested but
+local files, no console error, every link resolves. The fixture is large enough that the
+rule-firing heatmaps bin their columns (traces of 300+ iterations), the case that once drew
+blank plots.
 
 In CI (``CI`` set) a missing browser or Playwright is a failure, not a skip: ``.ci/run``
 installs Chromium when it is absent.
@@ -16,15 +22,30 @@ import json
 import os
 import re
 from pathlib import Path
+from urllib.parse import unquote, urlparse
 
 import pytest
-
-from conftest import FIXTURES, PROJECT
 
 CHROMIUM = Path(os.environ.get("XFUZZY_CHROMIUM", "/usr/bin/chromium"))
 ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
         "--disable-component-update", "--disable-sync", "--no-first-run"]
-EVIL = "<script>alert(1)</script>"
+PLANNERS = ["rrt", "fuzzy-rrt:general", "fuzzy-rrt:paper", "ompl:RRTConnect"]
+N_SCENARIOS = 24
+#: The overview must respond within this time (issue 16) and weigh at most this much (without
+#: the shared plotly.js).
+INTERACTIVE_MS = 2000
+OVERVIEW_BYTES = 1_500_000
+
+#: Per figure, the number of drawn marks: line/marker/bar/box paths with real coordinates and
+#: heatmap images with a positive width (a plot whose axis plotly misread draws none).
+MARKS_JS = """() => Array.from(document.querySelectorAll('.plotly-graph-div')).map(d => {
+  let n = 0;
+  d.querySelectorAll('path.js-line, path.point, .bars path, .boxlayer path, path.js-fill')
+    .forEach(p => { const a = p.getAttribute('d');
+                    if (a && a.length > 3 && a.indexOf('NaN') < 0) n++; });
+  d.querySelectorAll('image').forEach(i => {
+    if (parseFloat(i.getAttribute('width')) > 0) n++; });
+  return [d.id, n]; })"""
 
 
 def _unavailable(reason: str):
@@ -34,21 +55,31 @@ def _unavailable(reason: str):
 
 
 @pytest.fixture(scope="module")
-def report(tmp_path_factory) -> Path:
-    """RRT and Fuzzy-RRT on two scenarios, one of them named like a script."""
+def site(tmp_path_factory) -> Path:
+    """The bench folder of 24 generated scenarios × 4 planners, written by the CLI's writer."""
+    from xfuzzy_rrt.atomic import write_text_atomic
     from xfuzzy_rrt.bench.runner import run_benchmark
     from xfuzzy_rrt.cli.bench import write_outputs
     from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.planners.api import check_planner
+
+    try:
+        check_planner("ompl:RRTConnect", "--planners")
+    except Exception as exc:  # the OMPL extra is part of the test extras
+        _unavailable(f"OMPL is not available: {exc}")
+    from xfuzzy_rrt.scenarios.generate import generate_one
 
     out = tmp_path_factory.mktemp("browser")
-    evil = out / "evil.toml"
-    text = (FIXTURES / "scenarios" / "two-circles.toml").read_text()
-    evil.write_text(re.sub(r"^name = .*$", f'name = "{EVIL}"', text, count=1, flags=re.M))
-    scenarios = [load_scenario(evil), load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml")]
-    result = run_benchmark(scenarios, ["rrt", "fuzzy-rrt"], runs=3,
-                           rulebook=PROJECT / "rulebooks" / "expert")
-    write_outputs(result, out / "bench", "xfuzzy-rrt bench evil.toml boxes-and-circle.toml")
-    return out / "bench" / "report.html"
+    scenarios = []
+    for k in range(N_SCENARIOS):
+        problem = generate_one(2000, k)
+        path = out / "scenarios" / f"{problem.scenario.name}.toml"
+        write_text_atomic(path, problem.text)
+        scenarios.append(load_scenario(path))
+    result = run_benchmark(scenarios, PLANNERS, runs=2, max_iter=3000)
+    write_outputs(result, out / "bench", "xfuzzy-rrt bench scenarios/ --planners "
+                  + ",".join(PLANNERS) + " --runs 2 --max-iter 3000")
+    return out / "bench"
 
 
 @pytest.fixture(scope="module")
@@ -65,79 +96,144 @@ def browser():
         b.close()
 
 
-@pytest.fixture(scope="module")
-def opened(browser, report):
-    """The report opened and fully drawn; what the page logged and requested meanwhile."""
+def _open(browser, url: str):
+    """A page opened at ``url`` with every figure drawn; what it logged and requested."""
     page = browser.new_page(viewport={"width": 1400, "height": 900})
     seen = {"errors": [], "requests": [], "dialogs": []}
     page.on("console", lambda m: seen["errors"].append(m.text) if m.type == "error" else None)
     page.on("pageerror", lambda e: seen["errors"].append(str(e)))
     page.on("request", lambda r: seen["requests"].append(r.url))
     page.on("dialog", lambda d: (seen["dialogs"].append(d.message), d.dismiss()))
-    page.goto(report.as_uri(), wait_until="load")
+    page.goto(url, wait_until="load")
     page.evaluate("() => XF.renderAll()")  # a promise: awaited by Playwright
-    page.wait_for_timeout(300)
-    yield page, seen
+    page.wait_for_timeout(100)
+    return page, seen
+
+
+def _pages(site: Path) -> list[Path]:
+    return [site / "report.html"] + sorted((site / "report").glob("*.html"))
+
+
+def test_overview_answers_on_the_first_screen_within_two_seconds(browser, site, tmp_path):
+    from PIL import Image, ImageStat
+
+    html = site / "report.html"
+    assert html.stat().st_size <= OVERVIEW_BYTES
+    # Interactive: the document is parsed and its scripts have run (DOMContentLoaded) -- the
+    # verdict, tables and the SVG ratio plot are in the HTML; plotly.js arrives asynchronously.
+    # Best of three loads: the machine's other work should not decide the measurement.
+    times = []
+    for _ in range(3):
+        page = browser.new_page(viewport={"width": 1400, "height": 900})
+        page.goto(html.as_uri(), wait_until="domcontentloaded")
+        times.append(page.evaluate("() => performance.getEntriesByType('navigation')[0]"
+                                   ".domContentLoadedEventEnd"))
+        page.close()
+    assert min(times) <= INTERACTIVE_MS, times
+    page, seen = _open(browser, html.as_uri())
+    boxes = {sel: page.eval_on_selector(sel, "e => { const r = e.getBoundingClientRect(); "
+                                             "return [r.top, r.bottom, r.width]; }")
+             for sel in ("#verdict", "#ratio-plot")}
+    for sel, (top, bottom, width) in boxes.items():
+        assert 0 <= top < bottom <= 900 and width > 600, (sel, top, bottom)
+    verdict = page.text_content("#verdict")
+    assert "Fuzzy-RRT general" in verdict and "Fuzzy-RRT paper" in verdict
+    assert "OMPL RRTConnect finds its first path" in verdict
+    assert f"on {N_SCENARIOS} problems" in verdict
+    points = page.eval_on_selector_all("#ratio-plot a.xf-point", "els => els.length")
+    assert points == 3 * N_SCENARIOS
+    png = page.screenshot()  # the viewport: 1400 × 900, no scrolling
+    (tmp_path / "overview.png").write_bytes(png)
+    image = Image.open(io.BytesIO(png)).convert("L")
+    assert image.size == (1400, 900)
+    top, bottom = int(boxes["#ratio-plot"][0]), int(boxes["#ratio-plot"][1])
+    plot = image.crop((0, top, 1400, bottom))
+    assert ImageStat.Stat(plot).stddev[0] > 10.0  # points and grid drawn, not blank
+    assert seen["errors"] == []
     page.close()
 
 
-def test_every_plot_is_drawn_without_errors_or_network(opened, report):
-    page, seen = opened
-    html = report.read_text(encoding="utf-8")
-    ids = re.findall(r'<div id="(fig-[^"]+)" class="plotly-graph-div"', html)
-    assert len(ids) >= 10
-    drawn = page.evaluate("""() => Array.from(document.querySelectorAll('.plotly-graph-div'))
-        .filter(d => d.querySelector('svg.main-svg, canvas')).map(d => d.id)""")
-    assert sorted(drawn) == sorted(ids)
-    assert seen["errors"] == []
-    assert seen["requests"] and all(u.startswith("file://") for u in seen["requests"]), \
-        [u for u in seen["requests"] if not u.startswith("file://")]
-    assert seen["dialogs"] == []  # the scenario named <script>alert(1)</script> stayed text
-    headings = page.eval_on_selector_all("h2", "els => els.map(e => e.textContent)")
-    assert f"Scenario: {EVIL}" in headings
+def test_a_ratio_point_opens_its_scenario(browser, site):
+    page, _ = _open(browser, (site / "report.html").as_uri())
+    href = page.eval_on_selector("#ratio-plot a.xf-point", "a => a.getAttribute('href')")
+    page.click("#ratio-plot a.xf-point circle")
+    page.wait_for_load_state("load")
+    assert page.url == (site / href).resolve().as_uri()
+    assert page.text_content("h1").startswith("Scenario: ")
+    page.close()
 
 
-def test_drilldown_slider_shows_the_chosen_iteration(opened, report):
+def test_every_figure_on_every_page_is_drawn_without_errors_or_network(browser, site):
+    pages = _pages(site)
+    assert len(pages) == 1 + N_SCENARIOS + 2  # overview, scenarios, two rulebooks
+    binned = 0
+    for path in pages:
+        page, seen = _open(browser, path.as_uri())
+        html = path.read_text(encoding="utf-8")
+        ids = re.findall(r'<div id="(fig-[^"]+)" class="plotly-graph-div"', html)
+        marks = dict(page.evaluate(MARKS_JS))
+        assert sorted(marks) == sorted(ids), path.name
+        blank = [i for i, n in marks.items() if n == 0]
+        assert blank == [], f"{path.name}: figures without marks: {blank}"
+        assert seen["errors"] == [], f"{path.name}: {seen['errors'][:3]}"
+        assert seen["requests"] and all(u.startswith("file://") for u in seen["requests"]), \
+            [u for u in seen["requests"] if not u.startswith("file://")]
+        assert seen["dialogs"] == []
+        for fig_id in (i for i in ids if i.endswith("-firing")):
+            xs = page.evaluate(f"() => document.getElementById('{fig_id}').data[0].x")
+            binned += any("-" in str(x) for x in xs)  # columns are bins of iterations
+        page.close()
+    assert binned >= 1  # the fixture has traces long enough to bin (the blank-figure case)
+
+
+def test_every_link_resolves(browser, site):
+    for path in _pages(site):
+        html = path.read_text(encoding="utf-8")
+        for href in re.findall(r'href="([^"]+)"', html):
+            url = urlparse(href)
+            assert url.scheme in ("", "file"), f"{path.name}: external link {href}"
+            target = (path.parent / unquote(url.path)).resolve() if url.path else path
+            assert target.is_file(), f"{path.name}: broken link {href}"
+            if url.fragment:
+                text = target.read_text(encoding="utf-8", errors="replace")
+                assert f'id="{url.fragment}"' in text, f"{path.name}: no anchor {href}"
+
+
+def test_drilldown_slider_shows_the_chosen_iteration(browser, site):
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
     from xfuzzy_rrt.fuzzy.text_format import rule_sentence
+    from xfuzzy_rrt.report.numbers import readable_numbers
 
-    page, seen = opened
-    html = report.read_text(encoding="utf-8")
-    data = json.loads(re.search(r'<script type="application/json" id="drill-s0-data">(.*?)'
+    bench = json.loads((site / "bench.json").read_text())
+    rb_dir = next(e["dir"] for e in bench["rulebooks"] if e["planner"] == "fuzzy-rrt:general")
+    rb = load_rulebook(rb_dir)
+    path = next(p for p in sorted((site / "report").glob("scenario-*.html"))
+                if 'id="drill-s1-data"' in p.read_text(encoding="utf-8"))
+    html = path.read_text(encoding="utf-8")
+    data = json.loads(re.search(r'<script type="application/json" id="drill-s1-data">(.*?)'
                                 r"</script>", html, re.S).group(1))
+    assert data["rulebook"] == "general"
+    page, seen = _open(browser, path.as_uri())
     last = len(data["iterations"]) - 1
     record = data["iterations"][last]
-    page.eval_on_selector(".xf-drill input[type=range]",
+    root = "#follow-fuzzy-rrt-general ~ .xf-drill"
+    page.eval_on_selector(f"{root} input[type=range]",
                           f"s => {{ s.value = {last}; s.dispatchEvent(new Event('input')); }}")
     page.wait_for_timeout(300)
-    label = page.text_content(".xf-drill .xf-drill-label")
-    assert label.startswith(f"iteration {record['iteration']} ")
-    # The fired-rule sentences the page writes are the rulebook's own sentences.
-    rb = load_rulebook(PROJECT / "rulebooks" / "expert")
+    assert page.text_content(f"{root} .xf-drill-label").startswith(
+        f"iteration {record['iteration']} ")
     cells = page.evaluate(
-        "() => Array.from(document.querySelector('.xf-drill').querySelectorAll("
+        f"() => Array.from(document.querySelector('{root}').querySelectorAll("
         "'.xf-drill-systems .cell')).map(c => Array.from(c.querySelectorAll("
         "'table:last-of-type tbody tr')).map(r => Array.from(r.cells).map(x => x.textContent)))")
     assert len(cells) == 6
     for f, rows in enumerate(cells):
-        output, _, rules, _, _ = record["systems"][f]
+        _, _, rules, _, _ = record["systems"][f]
         assert [r[0] for r in rows] == [f"r{idx}" for idx, _, _ in rules]
         for row, (idx, strength, contribution) in zip(rows, rules):
-            assert row[1] == rule_sentence(rb.systems[f], idx)
+            assert row[1] == readable_numbers(rule_sentence(rb.systems[f], idx))
             assert row[2] == strength and row[4] == contribution
-    box = page.evaluate("() => document.getElementById('fig-s0-drill').layout.shapes[0]")
+    box = page.evaluate("() => document.getElementById('fig-s1-drill').layout.shapes[0]")
     assert [box["x0"], box["x1"], box["y0"], box["y1"]] == pytest.approx(record["box"])
     assert seen["errors"] == []
-
-
-def test_screenshot_is_not_blank(opened, tmp_path):
-    from PIL import Image, ImageStat
-
-    page, _ = opened
-    page.eval_on_selector("#fig-s0-rrt-joint", "e => e.scrollIntoView()")
-    page.wait_for_timeout(200)
-    png = page.screenshot()
-    (tmp_path / "shot.png").write_bytes(png)
-    image = Image.open(io.BytesIO(png)).convert("L")
-    assert ImageStat.Stat(image).stddev[0] > 10.0
-    assert sum(1 for count in image.histogram() if count) > 20  # grey levels used
+    page.close()

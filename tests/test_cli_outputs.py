@@ -109,7 +109,8 @@ def test_a_second_bench_into_the_same_folder_replaces_it_as_a_set(run_cli, tmp_p
     files = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file())
     examples = sorted({f"examples/{e['tree']}" for e in index})
     assert files == ["bench.json", *examples, "examples/index.json", "ratios.csv",
-                     "report.html", "runs.csv", "summary.csv"]
+                     "report.html", "report/plotly.min.js", "report/scenario-00-two-circles.html",
+                     "runs.csv", "summary.csv"]
     assert set(pd.read_csv(out / "runs.csv")["scenario"]) == {"two-circles"}
     assert [p.name for p in tmp_path.iterdir()] == ["bench"], "a staging folder was left"
 

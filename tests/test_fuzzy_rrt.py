@@ -177,7 +177,7 @@ def test_cli_trace_and_explain_agree_with_each_other(run_cli, tmp_path, suffix):
     it = max(1, result["iterations"] // 3)
     row = t[t["iteration"] == it].iloc[0]
     for source in (trace_file, result_file):
-        proc = run_cli("explain", source, "--iteration", str(it))
+        proc = run_cli("explain", source, "--iteration", str(it), "--exact")
         assert proc.returncode == 0, proc.stderr
         for out in load_rulebook(default_rulebook_path()).outputs:
             line = next(l for l in proc.stdout.splitlines() if l.startswith(f"  {out} = "))

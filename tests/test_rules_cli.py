@@ -11,6 +11,7 @@ from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 from xfuzzy_rrt.fuzzy.variables import INPUTS, OUTPUTS, rule_terms
 
 from _rulebook_helpers import EXPERT, copy_expert, random_inputs
+from conftest import PROJECT
 
 
 def _write_inputs(path, X):
@@ -103,8 +104,9 @@ def test_editing_one_rule_changes_eval_exactly_where_it_fires(run_cli, tmp_path)
 def test_show_summarises_and_finds_rules_by_condition(run_cli):
     proc = run_cli("rules", "show", EXPERT)
     assert proc.returncode == 0, proc.stderr
-    for needle in ("rulebook 'expert'", "kind: hand-written", "dist_to_goal [0, 0.6]: very_near @ 0",
-                   "rules: 625 per system", "goal_bias", "step_size", "sha256"):
+    for needle in ("rulebook 'expert'", "kind: hand-written",
+                   "dist_to_goal [0, 0.6] m: very_near @ 0", "rules: 625 per system",
+                   "goal_bias", "step_size", "sha256"):
         assert needle in proc.stdout
     proc = run_cli("rules", "show", EXPERT, "--when", "dist_to_goal=near,dist_to_obstacle=very_far")
     assert proc.returncode == 0
@@ -123,3 +125,31 @@ def test_export_import_round_trip_through_the_cli(run_cli, tmp_path):
         assert np.array_equal(a, b)
     proc = run_cli("rules", "export", EXPERT, "--format", "json", "--out", tmp_path / "x")
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
+
+
+def test_show_and_eval_print_numbers_people_read_and_files_keep_every_digit(run_cli, tmp_path):
+    """4 significant digits on the terminal; ``--exact`` and the CSV keep full precision."""
+    import re
+
+    def too_precise(text: str) -> list[str]:
+        """Decimal numbers with more than 4 significant digits."""
+        nums = re.findall(r"(?<![\w.])-?\d+\.\d+(?:e[-+]?\d+)?(?![\w.])", text)
+        return [n for n in nums
+                if len(n.split("e")[0].lstrip("-").replace(".", "").lstrip("0")) > 4]
+
+    rb = PROJECT / "rulebooks" / "general"
+    for args in ((), ("--rules",), ("--when", "dist_to_goal=near")):
+        proc = run_cli("rules", "show", rb, *args)
+        assert proc.returncode == 0, proc.stderr
+        assert too_precise(proc.stdout) == [], args
+    exact = run_cli("rules", "show", rb, "--rules", "--exact")
+    assert too_precise(exact.stdout)
+    inp = tmp_path / "in.csv"
+    inp.write_text("angle_to_goal,dist_to_goal,angle_to_obstacle,dist_to_obstacle\n"
+                   "1.0,0.2,2.0,0.3\n")
+    out = tmp_path / "out.csv"
+    proc = run_cli("rules", "eval", rb, "--input", inp, "--output", out)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith(f"wrote 1 rows to {out} (full precision)")
+    assert "dist_to_goal (m)" in proc.stdout and too_precise(proc.stdout) == []
+    assert too_precise(out.read_text())

@@ -38,18 +38,16 @@ class ProgressBar:
 
 
 def write_outputs(result, out: Path, command: str):
-    """Write the tables, bench.json, the example runs and report.html into ``out`` (the staged
-    folder; :func:`xfuzzy_rrt.bench.store.staged_folder` swaps it in)."""
-    from xfuzzy_rrt.atomic import atomic_path
+    """Write the tables, bench.json, the example runs, report.html and report/ into ``out``
+    (the staged folder; :func:`xfuzzy_rrt.bench.store.staged_folder` swaps it in)."""
     from xfuzzy_rrt.bench.provenance import collect
     from xfuzzy_rrt.bench.store import write_bench_dir
     from xfuzzy_rrt.cli.common import test_signal
-    from xfuzzy_rrt.report.bench_report import write_bench_report
+    from xfuzzy_rrt.report.site import write_report
 
     result = write_bench_dir(result, out, collect(command))
     test_signal("tables")
-    with atomic_path(out / "report.html") as tmp:
-        write_bench_report(result, tmp, command=command)
+    write_report(result, out, command=command)
     test_signal("report")
     return result
 

@@ -13,13 +13,21 @@ def explain(
     iteration: int = typer.Option(..., "--iteration", min=1, help="Iteration to explain (1-based)."),
     rulebook: Optional[Path] = typer.Option(
         None, "--rulebook", help="Rulebook that made the trace (default: the one the source names)."),
+    exact: bool = typer.Option(False, "--exact", help="Full precision (every digit, to re-derive "
+                               "the numbers bit for bit) instead of 4 significant digits."),
 ) -> int:
     """Print inputs, active terms, fired rules with strengths and contributions, and outputs."""
     from xfuzzy_rrt.analysis.explain import explain_row, render_text, trace_row
     from xfuzzy_rrt.planners.replay import trace_for
 
     frame, rb = trace_for(source, rulebook)
-    typer.echo(render_text(explain_row(trace_row(frame, iteration), rb)), nl=False)
+    e = explain_row(trace_row(frame, iteration), rb)
+    if exact:
+        typer.echo(render_text(e), nl=False)
+    else:
+        from xfuzzy_rrt.report.explain_text import render_readable, units_of
+
+        typer.echo(render_readable(e, units_of(rb)), nl=False)
     return 0
 
 

@@ -47,7 +47,31 @@ def eval_(
     result = evaluate_frame(rb, df)
     with atomic_path(output) as tmp:
         result.to_csv(tmp, index=False, float_format="%.17g")
+    _out(_eval_echo(result, rb, output))
     return 0
+
+
+#: Rows of ``rules eval`` output echoed on the terminal (the file has them all).
+ECHO_ROWS = 5
+
+
+def _eval_echo(result, rb, output: Path) -> str:
+    """What ``rules eval`` wrote, and its first rows with 4 significant digits and units (the
+    file keeps full precision)."""
+    from xfuzzy_rrt.report.fuzzy_figures import semantics, with_unit
+    from xfuzzy_rrt.report.numbers import sig
+
+    units = semantics(rb)[4]
+    head = result.head(ECHO_ROWS)
+    cols = list(head.columns)
+    table = [[with_unit(c, units) for c in cols]]
+    for _, row in head.iterrows():
+        table.append([sig(v) if isinstance(v, (int, float)) else str(v) for v in row])
+    widths = [max(len(r[j]) for r in table) for j in range(len(cols))]
+    lines = [f"wrote {len(result)} rows to {output} (full precision); first "
+             f"{len(head)}:"]
+    lines += ["  " + "  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in table]
+    return "\n".join(lines)
 
 
 @app.command("lint")
@@ -62,7 +86,16 @@ def lint(rulebook: Path = typer.Argument(..., help="Rulebook directory.")) -> in
 
 
 def _num(v: float) -> str:
-    return f"{v:.6g}"
+    """Numbers for people: 4 significant digits (the rulebook files keep every digit)."""
+    from xfuzzy_rrt.report.numbers import sig
+
+    return sig(v)
+
+
+def _readable(text: str, exact: bool) -> str:
+    from xfuzzy_rrt.report.numbers import readable_numbers
+
+    return text if exact else readable_numbers(text)
 
 
 @app.command("show")
@@ -75,6 +108,8 @@ def show(
     ),
     rules: bool = typer.Option(False, "--rules", help="Print every FIS's rules in the compact "
                                "layout (fewest rules, 'any' terms; same constants)."),
+    exact: bool = typer.Option(False, "--exact", help="Print numbers with full precision "
+                               "instead of 4 significant digits."),
 ) -> int:
     """Readable summary: provenance, terms and peaks, rule count, consequent statistics."""
     from xfuzzy_rrt.fuzzy.manifest import thaw
@@ -91,7 +126,7 @@ def show(
         for s in rb.systems:
             part = min_partition(s.consts)
             lines.append(f"# {s.output}: {len(part)} rules (compact, exact)")
-            lines += [pattern_sentence(s, pat, v) for pat, v in part.rules]
+            lines += [_readable(pattern_sentence(s, pat, v), exact) for pat, v in part.rules]
         _out("\n".join(lines))
         return 0
     if when:
@@ -102,7 +137,7 @@ def show(
         table = [header]
         for r, t, values in rows:
             table.append([f"r{r}", *(inputs[i].terms[t[i]] for i in range(len(rb.inputs))),
-                          *(_num(v) for v in values)])
+                          *(repr(float(v)) if exact else _num(v) for v in values)])
         widths = [max(len(row[j]) for row in table) for j in range(len(header))]
         lines = ["  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip() for row in table]
         lines.append(f"{len(rows)} of {N_RULES} rules")
@@ -119,10 +154,21 @@ def show(
         for key, value in mapping.items():
             if isinstance(value, dict):
                 flat(f"{prefix}{key}.", value)
+            elif (isinstance(value, list) and len(value) > 3 and not exact
+                  and all(isinstance(v, dict) for v in value)):
+                names = [str(v.get("name", "?")) for v in value]
+                lines.append(f"  {prefix}{key}: {len(value)} entries ({names[0]} \u2026 "
+                             f"{names[-1]}; --exact lists them)")
             else:
-                lines.append(f"  {prefix}{key}: {value}")
+                text = str(value)
+                lines.append(f"  {prefix}{key}: "
+                             + (_readable(text, exact) if isinstance(value, float) else text))
 
     flat("", thaw(rb.provenance))
+    from xfuzzy_rrt.report.fuzzy_figures import semantics
+    from xfuzzy_rrt.report.numbers import unit_of
+
+    units = semantics(rb)[4]
     lines.append("inputs (terms @ peaks; the first and last terms are shoulders):")
     shared = all(s.inputs == rb.systems[0].inputs for s in rb.systems)
     groups = [("all systems", rb.systems[0])] if shared else [(s.output, s) for s in rb.systems]
@@ -131,8 +177,11 @@ def show(
             lines.append(f"  [{label}]")
         for inp in s.inputs:
             lo, hi = inp.range
-            terms = ", ".join(f"{t} @ {_num(p)}" for t, p in zip(inp.terms, inp.peaks))
-            lines.append(f"  {inp.name} [{_num(lo)}, {_num(hi)}]: {terms}")
+            num = (lambda v: repr(float(v))) if exact else _num
+            unit = units.get(inp.name, "")
+            unit = " " + unit_of(unit) if unit else ""
+            terms = ", ".join(f"{t} @ {num(p)}" for t, p in zip(inp.terms, inp.peaks))
+            lines.append(f"  {inp.name} [{num(lo)}, {num(hi)}]{unit}: {terms}")
     lines.append(f"rules: {N_RULES} per system, {N_RULES * len(rb.systems)} in all")
     lines.append("consequents:")
     stats = consequent_stats(rb)

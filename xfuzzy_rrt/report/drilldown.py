@@ -3,11 +3,11 @@
 Why it reuses :mod:`xfuzzy_rrt.analysis.explain` instead of computing anything: the auditor
 must see *the same numbers* ``xfuzzy-rrt explain`` prints. So each selected iteration is
 explained by :func:`~xfuzzy_rrt.analysis.explain.explain_row` and its numbers are formatted with
-the very format specifications of :func:`~xfuzzy_rrt.analysis.explain.render_text` (the tests
-check every string against that text); the decision lines are taken verbatim from it.
+the very format functions of :mod:`.explain_text` that the command uses (4 significant digits,
+units from the rulebook; the tests check every string against its output).
 
-Why only some iterations: one iteration costs ~4 kB (six systems, up to 16 rules each, 12
-significant digits), and a report may hold dozens of scenarios. :func:`select_iterations` keeps
+Why only some iterations: one iteration costs ~2 kB (six systems, up to 16 rules each), and a
+report may hold dozens of scenarios. :func:`select_iterations` keeps
 the expansions that built the returned path (plus the first iteration and a few rejections),
 within a per-report budget; any other iteration is one ``explain`` command away (the page
 gives it).
@@ -62,40 +62,6 @@ def select_iterations(trace: pd.DataFrame, k: int) -> list[int]:
     return sorted(chosen)[:k]
 
 
-# The format specifications of render_text, named (the tests compare against its output).
-def fmt_input(x: float) -> str:
-    return repr(x)
-
-
-def fmt_degree(x: float) -> str:
-    return f"{x:.6g}"
-
-
-def fmt_strength(x: float) -> str:
-    return f"{x:.12g}"
-
-
-def fmt_constant(x: float) -> str:
-    return repr(x)
-
-
-def fmt_value(x: float) -> str:
-    return repr(x)
-
-
-def _decision_lines(e: Explanation) -> list[str]:
-    text = render_text(e).splitlines()
-    if "Decision:" not in text:
-        return []
-    start = text.index("Decision:") + 1
-    out = []
-    for line in text[start:]:
-        if not line.strip():
-            break
-        out.append(line.strip())
-    return out
-
-
 def _num(x: Any) -> float | None:
     try:
         v = float(x)
@@ -104,25 +70,25 @@ def _num(x: Any) -> float | None:
     return v if np.isfinite(v) else None
 
 
-def iteration_record(e: Explanation, consts: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """One iteration for the page: strings as ``explain`` prints them, coordinates as numbers.
+def iteration_record(e: Explanation, consts: dict[str, dict[str, Any]],
+                     units: dict[str, str] | None = None) -> dict[str, Any]:
+    """One iteration for the page: strings as ``xfuzzy-rrt explain`` prints them (readable
+    numbers, :mod:`.explain_text`), coordinates as numbers.
 
     Per system: ``[output, active, rules, value, recorded]`` where ``active`` is ``None`` when
     identical to the previous system's (the usual case: shared partitions) and each rule is
-    ``[index, strength, contribution]``; rule constants go once into ``consts`` (per output:
-    ``repr`` as explain prints it, or ``[sentence text, repr]`` when the sentence writes the
-    number differently).
+    ``[index, strength, contribution]``; rule constants go once into ``consts`` (per output).
     """
-    from xfuzzy_rrt.fuzzy.text_format import fnum
-    from xfuzzy_rrt.fuzzy.variables import INPUTS
+    from xfuzzy_rrt.report.explain_text import (decision_lines, fmt_constant, fmt_degree,
+                                                fmt_input, fmt_strength, fmt_value, input_note)
 
+    units = units or {}
     systems = []
     previous = None
     for s in e.systems:
         book = consts.setdefault(s.output, {})
         for r in s.rules:
-            text, rep = fnum(r.constant), fmt_constant(r.constant)
-            book.setdefault(str(r.index), rep if text == rep else [text, rep])
+            book.setdefault(str(r.index), fmt_constant(r.constant))
         active = [[name, ", ".join(f"{t.term} {fmt_degree(t.degree)}" for t in terms)]
                   for name, terms in s.active.items()]
         systems.append([s.output, None if active == previous else active,
@@ -133,11 +99,11 @@ def iteration_record(e: Explanation, consts: dict[str, dict[str, Any]]) -> dict[
     d = e.decision
     return {
         "iteration": e.iteration,
-        "inputs": [[n, fmt_input(e.clamped_inputs[n]),
-                    "" if e.inputs[n] == e.clamped_inputs[n] else
-                    f"measured {e.inputs[n]!r}, clamped"] for n in INPUTS],
+        "inputs": [[n, fmt_input(e.clamped_inputs[n], units.get(n, "")),
+                    input_note(e.inputs[n], e.clamped_inputs[n], units.get(n, ""))]
+                   for n in e.inputs],
         "systems": systems,
-        "decision": _decision_lines(e),
+        "decision": decision_lines(render_text(e)),
         "outcome": str(d.get("outcome", "")),
         "box": [_num(d.get(k)) for k in ("box_q1_lo", "box_q1_hi", "box_q2_lo", "box_q2_hi")],
         "from": [_num(d.get("from_q1_deg")), _num(d.get("from_q2_deg"))],
@@ -156,8 +122,11 @@ def drilldown_payload(trace: pd.DataFrame, rulebook, iterations: list[int]) -> d
     """
     from xfuzzy_rrt.analysis.explain import trace_row
 
+    from xfuzzy_rrt.report.explain_text import units_of
+
     consts: dict[str, dict[str, Any]] = {}
-    records = [iteration_record(explain_row(trace_row(trace, it), rulebook), consts)
+    units = units_of(rulebook)
+    records = [iteration_record(explain_row(trace_row(trace, it), rulebook), consts, units)
                for it in iterations]
     terms = {s.output: [[i.name, list(i.terms)] for i in s.inputs] for s in rulebook.systems}
     return {"rulebook": rulebook.name, "bounds_mode": rulebook.bounds_mode,
@@ -209,8 +178,7 @@ DRILL_JS = r"""
         box.appendChild(tableOf(['input', 'active terms (degree)'], active));
         box.appendChild(tableOf(['rule', 'sentence', 'strength', 'constant', 'contribution'],
           s[2].map(function (r) { var c = data.consts[out][String(r[0])];
-            var text = Array.isArray(c) ? c[0] : c, rep = Array.isArray(c) ? c[1] : c;
-            return ['r' + r[0], sentence(out, r[0], text), r[1], rep, r[2]]; })));
+            return ['r' + r[0], sentence(out, r[0], c), r[1], c, r[2]]; })));
         systems.appendChild(box);
       });
       var p = XF.render(figId);

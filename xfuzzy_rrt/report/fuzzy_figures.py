@@ -6,7 +6,7 @@
   share the same partitions);
 - :func:`surface_figure` -- each output over two chosen inputs, the other two fixed;
 - :func:`training_figure` -- best / mean / median fitness per generation;
-- :func:`ratio_figure` -- per planner, the per-scenario median-iteration ratios to the baseline.
+- :func:`coverage_figure` -- how many rules fired over the traced runs, and how few decide.
 
 Dense traces are decimated for drawing (a run may have 10,000 iterations; a browser plot needs
 a few hundred columns): heatmap columns are *bins* of consecutive iterations showing the mean
@@ -25,8 +25,8 @@ import pandas as pd
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from xfuzzy_rrt.fuzzy.variables import INPUTS, MAX_FIRED, OUTPUTS, rule_terms
-from xfuzzy_rrt.report.figures import TEMPLATE, plot_text, planner_color, planner_label
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, rule_terms
+from xfuzzy_rrt.report.figures import TEMPLATE, plot_text
 
 MAX_HEATMAP_COLUMNS = 80
 MAX_HEATMAP_RULES = 24
@@ -35,6 +35,33 @@ SURFACE_GRID = 31
 SURFACE_AXES = ("dist_to_goal", "dist_to_obstacle")
 #: Low values blue, high values red (each panel's own range, stated in its title).
 SURFACE_COLORS = [[0.0, "#2166ac"], [0.5, "#f7f7f7"], [1.0, "#b2182b"]]
+
+
+DEGREE = "\u00b0"
+#: Units of the first edition's variables, used when a rulebook does not state its own.
+_DEFAULT_UNITS = {"angle_to_goal": "rad", "angle_to_obstacle": "rad", "dist_to_goal": "m",
+                  "dist_to_obstacle": "m", "goal_bias": "", "bound_1": "deg", "bound_2": "deg",
+                  "bound_3": "deg", "bound_4": "deg", "step_size": "deg"}
+
+
+def semantics(rulebook) -> tuple[tuple[str, ...], tuple[str, ...], dict, dict, dict]:
+    """``(inputs, outputs, input_ranges, output_ranges, units)`` of ``rulebook``: read from the
+    rulebook (``rulebook.semantics``) when it says, else the paper's variables."""
+    from xfuzzy_rrt.fuzzy import variables as V
+
+    sem = getattr(rulebook, "semantics", None) if rulebook is not None else None
+    if sem is not None:
+        units = dict(_DEFAULT_UNITS)
+        units.update(dict(getattr(sem, "units", {}) or {}))
+        return (tuple(sem.inputs), tuple(sem.outputs), dict(sem.input_ranges),
+                dict(sem.output_ranges), units)
+    return V.INPUTS, V.OUTPUTS, dict(V.INPUT_RANGES), dict(V.OUTPUT_RANGES), dict(_DEFAULT_UNITS)
+
+
+def with_unit(name: str, units: dict) -> str:
+    """``'dist_to_goal (m)'``, ``'bound_1 (°)'``, ``'goal_bias'``."""
+    u = units.get(name, "")
+    return f"{name} ({'°' if u == 'deg' else u})" if u else name
 
 
 def _bins(n: int, max_cols: int) -> np.ndarray:
@@ -115,24 +142,26 @@ def firing_heatmap(trace: pd.DataFrame, rulebook, max_cols: int = MAX_HEATMAP_CO
                                       + plot_text("; ".join(sub)) + "</sup>", x=0),
                       margin=dict(l=230, r=20, t=80, b=50))
     fig.update_xaxes(title_text="iteration", row=len(groups), col=1)
+    # Bin labels such as "4-5" would be read as dates by plotly (an empty plot and NaN widths):
+    # they are categories.
+    fig.update_xaxes(type="category")
     return fig
 
 
-def io_series(trace: pd.DataFrame, max_points: int = MAX_SERIES_POINTS) -> go.Figure:
+def io_series(trace: pd.DataFrame, max_points: int = MAX_SERIES_POINTS,
+              rulebook=None) -> go.Figure:
     """The four inputs and six outputs per iteration (every k-th iteration when dense)."""
     n = len(trace)
     step = max(1, math.ceil(n / max_points))
     view = trace.iloc[::step]
-    names = list(INPUTS) + ["goal_bias", "step_size", "bound_1", "bound_2", "bound_3", "bound_4"]
-    units = {"angle_to_goal": "rad", "angle_to_obstacle": "rad", "dist_to_goal": "m",
-             "dist_to_obstacle": "m", "goal_bias": "", "step_size": "deg"}
-    fig = make_subplots(rows=5, cols=2, shared_xaxes=True, vertical_spacing=0.05,
-                        horizontal_spacing=0.08,
-                        subplot_titles=[f"{c} ({units.get(c, 'deg')})" if units.get(c, "deg")
-                                        else c for c in names])
+    inputs, outputs, _, _, units = semantics(rulebook)
+    names = [c for c in list(inputs) + list(outputs) if c in trace.columns]
+    fig = make_subplots(rows=max(1, math.ceil(len(names) / 2)), cols=2, shared_xaxes=True,
+                        vertical_spacing=0.05, horizontal_spacing=0.08,
+                        subplot_titles=[with_unit(c, units) for c in names])
     x = view["iteration"].to_numpy(dtype=np.int32)
     for k, c in enumerate(names):
-        is_input = c in INPUTS
+        is_input = c in inputs
         fig.add_trace(go.Scatter(x=x, y=view[c].to_numpy(dtype=np.float64), mode="lines",
                                    name=c, showlegend=False,
                                    line=dict(width=1, color="#0072B2" if is_input else "#D55E00"),
@@ -161,10 +190,12 @@ def partition_groups(rulebook) -> list[tuple[list[str], Any]]:
     return groups
 
 
-def membership_figure(fis, outputs: list[str]) -> go.Figure:
-    """The five terms of each input of ``fis`` (exact piecewise-linear, drawn through knots)."""
-    fig = make_subplots(rows=1, cols=4, horizontal_spacing=0.06,
-                        subplot_titles=[i.name for i in fis.inputs])
+def membership_figure(fis, outputs: list[str], rulebook=None) -> go.Figure:
+    """The five terms of each input of ``fis`` (exact piecewise-linear, drawn through knots);
+    axis titles with units, term labels staggered on two rows so that neighbours never
+    overlap."""
+    units = semantics(rulebook)[4]
+    fig = make_subplots(rows=1, cols=len(fis.inputs), horizontal_spacing=0.05)
     palette = ("#0072B2", "#009E73", "#E69F00", "#CC79A7", "#D55E00")
     for c, inp in enumerate(fis.inputs):
         k = inp.peaks
@@ -180,55 +211,116 @@ def membership_figure(fis, outputs: list[str]) -> go.Figure:
                                      hovertemplate=plot_text(term)
                                      + " %{x:.4g}: %{y:.2f}<extra></extra>"),
                           row=1, col=c + 1)
-            fig.add_annotation(x=k[j], y=1.06, text=plot_text(term), showarrow=False,
-                               font=dict(size=9, color=palette[j]),
+            fig.add_annotation(x=k[j], y=1.07 if j % 2 == 0 else 1.2,
+                               text=f"{plot_text(term)} {_sig(k[j])}", showarrow=False,
+                               font=dict(size=10, color=palette[j]),
                                xref=f"x{c + 1}" if c else "x", yref=f"y{c + 1}" if c else "y")
-    fig.update_yaxes(range=[0, 1.15])
-    fig.update_layout(template=TEMPLATE, height=280, margin=dict(l=40, r=20, t=70, b=30),
+        fig.update_xaxes(title_text=with_unit(inp.name, units), row=1, col=c + 1)
+    fig.update_yaxes(range=[0, 1.3], tickvals=[0, 0.5, 1])
+    fig.update_layout(template=TEMPLATE, height=300, margin=dict(l=40, r=30, t=60, b=45),
                       title=dict(text="Membership functions \u2014 " + plot_text(", ".join(outputs)),
                                  x=0))
     return fig
 
 
-def surface_inputs(fis_list) -> dict[str, float]:
+def _sig(x: float) -> str:
+    from xfuzzy_rrt.report.numbers import sig
+
+    return sig(x, 3)
+
+
+def surface_axes(rulebook) -> tuple[str, str]:
+    """The two inputs a surface is drawn over: the two distances (unit ``m``) when the rulebook
+    has them, else its first two inputs."""
+    inputs, _, _, _, units = semantics(rulebook)
+    dist = [i for i in inputs if units.get(i) == "m"]
+    return (dist[0], dist[1]) if len(dist) >= 2 else (inputs[0], inputs[1])
+
+
+def surface_inputs(fis_list, axes: tuple[str, str] = SURFACE_AXES) -> dict[str, float]:
     """Fixed values for the inputs not on the surface axes: the middle peak of the first FIS."""
     first = fis_list[0]
-    return {i.name: float(i.peaks[2]) for i in first.inputs if i.name not in SURFACE_AXES}
+    return {i.name: float(i.peaks[2]) for i in first.inputs if i.name not in axes}
 
 
 def surface_figure(rulebook, n: int = SURFACE_GRID) -> tuple[go.Figure, dict[str, float]]:
-    """Each output over ``SURFACE_AXES`` (the compiled engine), the other inputs fixed."""
+    """Each output over two inputs (the compiled engine), the other inputs fixed; one colour
+    bar per panel, in the output's unit."""
     from xfuzzy_rrt.fuzzy.engine import evaluate
-    from xfuzzy_rrt.fuzzy.variables import INPUT_RANGES
 
-    fixed = surface_inputs(rulebook.systems)
-    ax, ay = SURFACE_AXES
-    xs = np.linspace(*INPUT_RANGES[ax], n)
-    ys = np.linspace(*INPUT_RANGES[ay], n)
+    inputs, outputs, in_ranges, _, units = semantics(rulebook)
+    ax, ay = surface_axes(rulebook)
+    fixed = surface_inputs(rulebook.systems, (ax, ay))
+    xs = np.linspace(*in_ranges[ax], n)
+    ys = np.linspace(*in_ranges[ay], n)
     gx, gy = np.meshgrid(xs, ys)
-    X = np.zeros((gx.size, len(INPUTS)))
-    for i, name in enumerate(INPUTS):
+    X = np.zeros((gx.size, len(inputs)))
+    for i, name in enumerate(inputs):
         X[:, i] = gx.ravel() if name == ax else gy.ravel() if name == ay else fixed[name]
     knots, consts = rulebook.arrays()
     Y = evaluate(knots, consts, X)
-    titles = [f"{out}: {Y[:, f].min():.4g} (blue) \u2026 {Y[:, f].max():.4g} (red)"
-              if Y[:, f].max() > Y[:, f].min() else f"{out}: constant {Y[0, f]:.4g}"
-              for f, out in enumerate(OUTPUTS)]
-    fig = make_subplots(rows=2, cols=3, subplot_titles=titles, horizontal_spacing=0.07,
-                        vertical_spacing=0.14)
-    for f, out in enumerate(OUTPUTS):
-        fig.add_trace(go.Heatmap(x=xs, y=ys, z=Y[:, f].reshape(n, n), colorscale=SURFACE_COLORS,
-                                 showscale=False, hovertemplate=f"{ax} %{{x:.3f}}<br>{ay} "
-                                 f"%{{y:.3f}}<br>{out} %{{z:.4g}}<extra></extra>"),
-                      row=f // 3 + 1, col=f % 3 + 1)
-    fig.update_xaxes(title_text=f"{ax} (m)")
-    fig.update_yaxes(title_text=f"{ay} (m)")
-    fixed_text = ", ".join(f"{k} = {v:.4g} rad" for k, v in fixed.items())
-    fig.update_layout(template=TEMPLATE, height=620, margin=dict(l=60, r=20, t=90, b=50),
-                      title=dict(text="Rule surfaces: each output over dist_to_goal \u00d7 "
-                                      f"dist_to_obstacle<br><sup>fixed: {plot_text(fixed_text)}"
+    titles = [with_unit(out, units) if Y[:, f].max() > Y[:, f].min()
+              else f"{with_unit(out, units)}: constant {_sig(Y[0, f])}"
+              for f, out in enumerate(outputs)]
+    fig = make_subplots(rows=2, cols=3, subplot_titles=titles, horizontal_spacing=0.11,
+                        vertical_spacing=0.16)
+    for f, out in enumerate(outputs):
+        row, col = f // 3 + 1, f % 3 + 1
+        xd = fig.get_subplot(row, col).xaxis.domain
+        yd = fig.get_subplot(row, col).yaxis.domain
+        u = units.get(out, "")
+        fig.add_trace(go.Heatmap(
+            x=xs, y=ys, z=Y[:, f].reshape(n, n), colorscale=SURFACE_COLORS, showscale=True,
+            colorbar=dict(x=xd[1] + 0.008, y=(yd[0] + yd[1]) / 2, len=yd[1] - yd[0],
+                          thickness=10, xanchor="left", tickfont=dict(size=9),
+                          title=dict(text=DEGREE if u == "deg" else u, side="right")),
+            hovertemplate=f"{ax} %{{x:.3g}}<br>{ay} %{{y:.3g}}<br>{out} %{{z:.4g}}"
+                          "<extra></extra>"), row=row, col=col)
+    fig.update_xaxes(title_text=with_unit(ax, units))
+    fig.update_yaxes(title_text=with_unit(ay, units))
+    fixed_text = ", ".join(f"{k} = {_sig(v)} {units.get(k, '')}".rstrip()
+                           for k, v in fixed.items())
+    fig.update_layout(template=TEMPLATE, height=660, margin=dict(l=60, r=40, t=90, b=50),
+                      title=dict(text=f"Rule surfaces: each output over {plot_text(ax)} \u00d7 "
+                                      f"{plot_text(ay)}<br><sup>fixed: {plot_text(fixed_text)}"
                                       " (hover for values)</sup>", x=0))
     return fig, fixed
+
+
+def coverage_figure(traces: list, rulebook) -> go.Figure | None:
+    """Per output: how many of its rules fired at least once over ``traces``, and how many
+    carry 90 % of the summed firing strength (a few rules usually decide)."""
+    traces = [t for t in traces if isinstance(t, pd.DataFrame) and len(t)]
+    if not traces:
+        return None
+    outputs = semantics(rulebook)[1]
+    n_rules = len(rulebook.systems[0].consts)
+    fired, core = [], []
+    for out in outputs:
+        w = np.zeros(n_rules)
+        for t in traces:
+            cols = [c for c in (f"{out}_rule_{k}" for k in range(MAX_FIRED)) if c in t]
+            r = t[cols].to_numpy()
+            st = t[[c.replace("_rule_", "_strength_") for c in cols]].to_numpy()
+            m = r >= 0
+            w += np.bincount(r[m], weights=st[m], minlength=n_rules)
+        order = np.sort(w)[::-1]
+        total = order.sum()
+        fired.append(int(np.count_nonzero(w > 0)))
+        core.append(int(np.searchsorted(np.cumsum(order), 0.9 * total) + 1) if total > 0 else 0)
+    fig = go.Figure()
+    fig.add_trace(go.Bar(x=list(outputs), y=fired, name="rules that fired",
+                         marker_color="#0072B2", text=fired, textposition="outside"))
+    fig.add_trace(go.Bar(x=list(outputs), y=core, name="rules carrying 90% of the strength",
+                         marker_color="#D55E00", text=core, textposition="outside"))
+    fig.update_xaxes(type="category")
+    fig.update_yaxes(title_text=f"rules (of {n_rules} per system)", rangemode="tozero")
+    fig.update_layout(template=TEMPLATE, height=360, barmode="group",
+                      margin=dict(l=60, r=20, t=60, b=40),
+                      legend=dict(orientation="h", y=1.02, yanchor="bottom", x=0),
+                      title=dict(text=f"Rule coverage over {len(traces)} traced run(s)", x=0,
+                                 y=0.98))
+    return fig
 
 
 def training_figure(history: pd.DataFrame) -> go.Figure:
@@ -245,32 +337,4 @@ def training_figure(history: pd.DataFrame) -> go.Figure:
     fig.update_layout(template=TEMPLATE, height=380, xaxis_title="generation",
                       yaxis_title="fitness", margin=dict(l=60, r=20, t=50, b=50),
                       title=dict(text="Training: fitness per generation", x=0))
-    return fig
-
-
-def ratio_figure(summary: pd.DataFrame, baseline: str = "rrt") -> go.Figure | None:
-    """Per planner, one dot per scenario: baseline median iterations / planner median."""
-    from xfuzzy_rrt.bench.summary import scenario_ratios
-    from xfuzzy_rrt.report.figures import planner_order
-
-    r = summary.assign(_r=scenario_ratios(summary, baseline))
-    r = r[(r["planner"] != baseline) & r["_r"].notna()]
-    if r.empty:
-        return None
-    fig = go.Figure()
-    for p in planner_order(r["planner"]):
-        g = r[r["planner"] == p]
-        fig.add_trace(go.Box(x=g["_r"].to_numpy(dtype=np.float64), name=plot_text(planner_label(p)),
-                             boxpoints="all", jitter=0.4, pointpos=0, orientation="h",
-                             marker=dict(color=planner_color(p), size=6),
-                             line=dict(color=planner_color(p)), fillcolor="rgba(0,0,0,0)",
-                             text=[plot_text(s) for s in g["scenario"]],
-                             hovertemplate="%{text}: %{x:.2f}<extra>" + plot_text(p) + "</extra>"))
-    fig.add_vline(x=1.0, line=dict(color="#444", dash="dash"))
-    fig.update_xaxes(type="log", title_text=f"{planner_label(baseline)} median iterations / "
-                     "planner median iterations (log; > 1: fewer iterations than the baseline)")
-    fig.update_layout(template=TEMPLATE, height=150 + 60 * r["planner"].nunique(),
-                      showlegend=False, margin=dict(l=110, r=20, t=50, b=60),
-                      title=dict(text="Per-scenario median-iteration ratio to "
-                                      f"{planner_label(baseline)}", x=0))
     return fig

@@ -51,6 +51,22 @@ details > summary { cursor: pointer; color: #0550ae; }
 .xf-drill { border-top: 1px solid #eee; padding-top: 6px; }
 .xf-drill h4 { margin: 6px 0 2px 0; font-size: 0.95em; }
 .xf-drill-systems table.data { font-size: 0.78em; }
+.scroll { overflow-x: auto; max-width: 100%; }
+.xf-nav { font-size: 0.9em; padding: 4px 0; border-bottom: 1px solid #eee; }
+h1.xf-title { font-size: 1.35em; margin: 6px 0 0 0; }
+p.xf-sub { margin: 2px 0 6px 0; font-size: 0.9em; }
+ul.xf-verdict { margin: 6px 0; padding: 6px 12px 6px 28px; background: #f4f8fc;
+                border-left: 4px solid #0072B2; line-height: 1.35; }
+ul.xf-verdict li { margin: 1px 0; }
+.xf-lose { color: #b2182b; font-weight: 600; }
+table.xf-planners { margin: 4px 0; }
+table.xf-planners th, table.xf-planners td { padding: 2px 7px; }
+table.xf-planners td:first-child { white-space: nowrap; font-weight: 600; }
+@page { size: A4 landscape; margin: 10mm; }
+@media print { .xf-nav { display: none; } body { padding: 0; max-width: none; }
+               .scroll { overflow: visible; } table.data { font-size: 0.8em; }
+               h2 { break-after: avoid; } .cell, svg, .fig { break-inside: avoid; }
+               .modebar-container { display: none !important; } }
 """
 
 #: Sets plotly's global config before plotly.js loads (as plotly's own full-page output does):
@@ -133,10 +149,13 @@ class Page:
     compacted and deduplicated (:mod:`.plotjson`) and drawn by one loader script at the end.
     """
 
-    def __init__(self, title: str) -> None:
+    def __init__(self, title: str, eager: bool = False) -> None:
         from xfuzzy_rrt.report.plotjson import SharedStore
 
         self.title = title
+        #: Draw every figure at load (a short page, or one that is printed) instead of as it
+        #: scrolls into view.
+        self.eager = eager
         self.parts: list[str] = []
         self.shared = SharedStore()
         self.figures: dict[str, Any] = {}
@@ -153,8 +172,11 @@ class Page:
     def paragraph(self, text: str, css_class: str = "note") -> None:
         self.parts.append(f'<p class="{esc(css_class)}">{esc(text)}</p>')
 
-    def figure(self, fig, div_id: str, height: int | None = None) -> str:
-        """Register ``fig`` under the fixed ``div_id``; return its placeholder ``<div>``."""
+    def figure(self, fig, div_id: str, height: int | None = None, links: bool = False) -> str:
+        """Register ``fig`` under the fixed ``div_id``; return its placeholder ``<div>``.
+
+        ``links``: a click on a point opens the relative URL in the point's ``customdata``.
+        """
         from xfuzzy_rrt.report.plotjson import figure_spec
 
         if div_id in self.figures:
@@ -163,6 +185,8 @@ class Page:
             fig.update_layout(height=height)
         h = int(fig.layout.height or 450)
         self.figures[div_id] = figure_spec(fig, self.shared)
+        if links:
+            self.figures[div_id]["links"] = True
         return (f'<div class="fig"><div id="{esc(div_id)}" class="plotly-graph-div" '
                 f'style="height:{h}px; width:100%;"></div></div>')
 
@@ -174,8 +198,10 @@ class Page:
         """Page script run after the figure loader (no user text may be interpolated here)."""
         self.scripts.append(js)
 
-    def render(self) -> str:
-        """The page, with plotly.js embedded exactly once in the head."""
+    def render(self, plotly_src: str | None = None) -> str:
+        """The page, with plotly.js embedded exactly once in the head -- or, with
+        ``plotly_src``, loaded asynchronously from that *relative* path (the report site's one
+        shared copy)."""
         from plotly.offline import get_plotlyjs
 
         from xfuzzy_rrt.report.plotjson import LOADER_JS, script_json
@@ -191,10 +217,16 @@ class Page:
             f"<title>{esc(self.title)}</title>\n",
             f"<style>{CSS}</style>\n",
             f"<script>{_PLOTLY_CONFIG}</script>\n",
-            '<script type="text/javascript">', get_plotlyjs(), "</script>\n",
+            ('<script type="text/javascript">' + get_plotlyjs() + "</script>\n")
+            if plotly_src is None else
+            # Loaded without blocking the page: text, tables and links are usable at once; the
+            # loader draws figures when plotly.js has arrived.
+            (f'<script async src="{esc(plotly_src)}" '
+             'onload="window.__xfPlotly &amp;&amp; window.__xfPlotly()"></script>\n'),
             "</head>\n<body>\n",
             "\n".join(self.parts),
             "\n", "\n".join(blocks),
-            "\n<script>", LOADER_JS, "\n".join(self.scripts), "</script>",
+            "\n<script>", LOADER_JS, "\n".join(self.scripts),
+            "\nXF.renderAll();" if self.eager else "", "</script>",
             "\n</body>\n</html>\n",
         ])

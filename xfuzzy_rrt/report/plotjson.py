@@ -19,10 +19,11 @@ which 4.8 MB plotly.js and 0.27 MB figures. Here:
 from __future__ import annotations
 
 import base64
+import contextlib
 import hashlib
 import json
 import math
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -122,11 +123,42 @@ def compact(value: Any, shared: SharedStore) -> Any:
     return value
 
 
+#: What ``template="none"`` serialises to.
+_EMPTY_TEMPLATE = {"data": {"scatter": [{"type": "scatter"}]}}
+_PAGE_TEMPLATE: list[dict] = []
+
+
+def page_template() -> dict[str, Any]:
+    """The report's look (:data:`xfuzzy_rrt.report.figures.PAGE_TEMPLATE`), built once."""
+    if not _PAGE_TEMPLATE:
+        import plotly.io as pio
+
+        from xfuzzy_rrt.report.figures import PAGE_TEMPLATE
+
+        _PAGE_TEMPLATE.append(pio.templates[PAGE_TEMPLATE].to_plotly_json())
+    return _PAGE_TEMPLATE[0]
+
+
+@contextlib.contextmanager
+def no_default_template() -> Iterator[None]:
+    """Build figures without plotly's default template object (see ``figures.TEMPLATE``)."""
+    import plotly.io as pio
+
+    previous = pio.templates.default
+    pio.templates.default = "none"
+    try:
+        yield
+    finally:
+        pio.templates.default = previous
+
+
 def figure_spec(fig, shared: SharedStore, config: dict[str, Any] | None = None) -> dict[str, Any]:
     """``{"data", "layout", "config"}`` for ``Plotly.newPlot``, compacted; the template shared."""
     raw = fig.to_plotly_json()
     layout = dict(raw.get("layout") or {})
     template = layout.pop("template", None)
+    if not template or template == _EMPTY_TEMPLATE:
+        template = page_template()
     spec = {"data": compact(raw.get("data") or [], shared), "layout": compact(layout, shared),
             "config": config or {"displaylogo": False, "responsive": True}}
     if template is not None:
@@ -166,10 +198,18 @@ window.XF = (function () {
     }
     return v;
   }
+  // plotly.js may arrive after this script (loaded async from the report folder).
+  var plotly = window.Plotly ? Promise.resolve() : new Promise(function (ok) { window.__xfPlotly = ok; });
   function render(id) {
     if (done[id] || !figs[id]) return done[id] || null;
     var f = resolve(figs[id]);
-    done[id] = Plotly.newPlot(id, f.data, f.layout, f.config);
+    done[id] = plotly.then(function () { return Plotly.newPlot(id, f.data, f.layout, f.config); }).then(function (gd) {
+      if (f.links) gd.on('plotly_click', function (e) {
+        var u = e.points && e.points[0] && e.points[0].customdata;
+        if (typeof u === 'string' && u) window.location.href = u;
+      });
+      return gd;
+    });
     return done[id];
   }
   function renderAll() { return Promise.all(Object.keys(figs).map(render)); }
@@ -180,6 +220,7 @@ window.XF = (function () {
     Object.keys(figs).forEach(function (id) { var el = document.getElementById(id); if (el) io.observe(el); });
   } else { renderAll(); }
   window.addEventListener('beforeprint', renderAll);
-  return {render: render, renderAll: renderAll, resolve: resolve, figs: figs, done: done};
+  return {render: render, renderAll: renderAll, resolve: resolve, figs: figs, done: done,
+          plotly: plotly};
 })();
 """

@@ -41,7 +41,7 @@ def check_planner(name: str, where: str = "--planners") -> str:
 
 def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None, seed: int = 0,
                   max_iter: int = 10_000, step_deg: float = 10.0, goal_bias: float = 0.05,
-                  trace: bool = False) -> PlanResult:
+                  trace: bool = False, clearance_m: float | None = None) -> PlanResult:
     """Plan ``scenario`` with the named planner.
 
     ``rulebook`` (fuzzy-rrt only) is a loaded rulebook, a directory path, or ``None`` for the
@@ -56,19 +56,19 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
         if trace:
             raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt")
         return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
-                        goal_bias=goal_bias)
+                        goal_bias=goal_bias, clearance_m=clearance_m)
     if planner == "fuzzy-rrt":
         from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
 
         return plan_fuzzy_rrt(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
-                               trace=trace)
+                               trace=trace, clearance_m=clearance_m)
     if is_known_planner(planner):
         from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 
         if trace:
             raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt")
         return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, step_deg=step_deg,
-                         goal_bias=goal_bias)
+                         goal_bias=goal_bias, clearance_m=clearance_m)
     raise InputError("--planner", f"unknown planner {planner!r} (expected one of {', '.join(PLANNERS)})")
 
 

@@ -36,7 +36,7 @@ from xfuzzy_rrt.geometry.collision import (
     effective_margin,
     link_motion_bound,
 )
-from xfuzzy_rrt.geometry.path_check import signed_clearance_kernel
+from xfuzzy_rrt.geometry.path_check import signed_segment_obstacle_dist
 
 #: The exact minimum clearance along a path is bracketed to within this (metres).
 MIN_CLEARANCE_TOL_M = 1e-9
@@ -107,52 +107,102 @@ class MinClearance:
 
 
 @nb.njit(cache=True, nogil=True)
+def link_clearances(links, base, radius, obstacles, q_deg, out):
+    """Signed clearance of each link capsule (``out[k]``) to its nearest obstacle; the min."""
+    best = np.inf
+    x = base[0]
+    y = base[1]
+    theta = 0.0
+    for k in range(links.shape[0]):
+        theta += math.radians(q_deg[k])
+        nx = x + links[k] * math.cos(theta)
+        ny = y + links[k] * math.sin(theta)
+        ck = np.inf
+        for o in range(obstacles.shape[0]):
+            d = signed_segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - radius
+            if d < ck:
+                ck = d
+        out[k] = ck
+        if ck < best:
+            best = ck
+        x = nx
+        y = ny
+    return best
+
+
+@nb.njit(cache=True, nogil=True)
+def _interval_bound(c0, c1, mk, width):
+    """Nothing on the interval is below this: min over links of ``(c0_k + c1_k - M_k w) / 2``."""
+    lb = np.inf
+    for k in range(c0.shape[0]):
+        v = 0.5 * (c0[k] + c1[k] - mk[k] * width)
+        if v < lb:
+            lb = v
+    return lb
+
+
+@nb.njit(cache=True, nogil=True)
 def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals):
-    """``(value, segment, s, lower bound)`` of the signed clearance along ``path`` (degrees)."""
+    """``(value, segment, s, lower bound)`` of the signed clearance along ``path`` (degrees).
+
+    Branch and bound per segment with one Lipschitz constant per link (``M_k``: inner links
+    move less, so a link that is far from everything stops costing evaluations early);
+    segments are visited in the order of their initial bound, so the best value is tight
+    early and prunes the rest.
+    """
     n = path.shape[0]
+    nl = links.shape[0]
     if obstacles.shape[0] == 0 or n == 0:
         return np.inf, -1, 0.0, np.inf
-    cv = np.empty(n, dtype=np.float64)
+    cv = np.empty((n, nl))
     best = np.inf
     best_seg = 0
     best_s = 0.0
     for i in range(n):
-        cv[i] = signed_clearance_kernel(links, base, radius, obstacles, path[i])
-        if cv[i] < best:
-            best = cv[i]
+        c = link_clearances(links, base, radius, obstacles, path[i], cv[i])
+        if c < best:
+            best = c
             if i < n - 1 or n == 1:
                 best_seg = i
                 best_s = 0.0
             else:
                 best_seg = n - 2
                 best_s = 1.0
+    if n == 1:
+        return best, best_seg, best_s, best
+    mks = np.empty((n - 1, nl))
+    first = np.empty(n - 1)
+    for i in range(n - 1):
+        for k in range(nl):
+            mks[i, k] = link_motion_bound(links, path[i], path[i + 1], k)
+        first[i] = _interval_bound(cv[i], cv[i + 1], mks[i], 1.0)
+    order = np.argsort(first)
     floor = np.inf
     evals = n
     cap = 256
     s0s = np.empty(cap)
     s1s = np.empty(cap)
-    c0s = np.empty(cap)
-    c1s = np.empty(cap)
+    c0s = np.empty((cap, nl))
+    c1s = np.empty((cap, nl))
+    cm = np.empty(nl)
     q = np.empty(path.shape[1])
-    last = links.shape[0] - 1
-    for i in range(n - 1):
+    for oi in range(n - 1):
+        i = order[oi]
+        if first[i] >= best - tol:
+            break  # sorted: no later segment can do better either
         qa = path[i]
         qb = path[i + 1]
-        m = link_motion_bound(links, qa, qb, last)  # M_k grows with k: the last link is max
-        if m <= 0.0:
-            continue
+        mk = mks[i]
         s0s[0] = 0.0
         s1s[0] = 1.0
-        c0s[0] = cv[i]
-        c1s[0] = cv[i + 1]
+        c0s[0, :] = cv[i]
+        c1s[0, :] = cv[i + 1]
         top = 1
         while top > 0:
             top -= 1
             s0 = s0s[top]
             s1 = s1s[top]
-            c0 = c0s[top]
-            c1 = c1s[top]
-            lb = 0.5 * (c0 + c1 - m * (s1 - s0))
+            lb = _interval_bound(c0s[top], c1s[top], mk, s1 - s0)
             if lb >= best - tol:
                 continue
             sm = 0.5 * (s0 + s1)
@@ -162,19 +212,33 @@ def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals):
                 continue
             for d in range(q.shape[0]):
                 q[d] = qa[d] + sm * (qb[d] - qa[d])
-            cm = signed_clearance_kernel(links, base, radius, obstacles, q)
+            c = link_clearances(links, base, radius, obstacles, q, cm)
             evals += 1
-            if cm < best:
-                best = cm
+            if c < best:
+                best = c
                 best_seg = i
                 best_s = sm
-            # The half with the smaller end value is explored first (pushed last).
-            if c0 <= c1:
-                s0s[top], s1s[top], c0s[top], c1s[top] = sm, s1, cm, c1
-                s0s[top + 1], s1s[top + 1], c0s[top + 1], c1s[top + 1] = s0, sm, c0, cm
+            # Both halves go on the stack; the one with the smaller bound is explored first.
+            c1_old = c1s[top].copy()
+            left = _interval_bound(c0s[top], cm, mk, sm - s0)
+            right = _interval_bound(cm, c1_old, mk, s1 - sm)
+            if left <= right:
+                # push right then left (left on top)
+                s0s[top + 1] = s0
+                s1s[top + 1] = sm
+                c0s[top + 1, :] = c0s[top]
+                c1s[top + 1, :] = cm
+                s0s[top] = sm
+                s1s[top] = s1
+                c0s[top, :] = cm
+                c1s[top, :] = c1_old
             else:
-                s0s[top], s1s[top], c0s[top], c1s[top] = s0, sm, c0, cm
-                s0s[top + 1], s1s[top + 1], c0s[top + 1], c1s[top + 1] = sm, s1, cm, c1
+                s0s[top + 1] = sm
+                s1s[top + 1] = s1
+                c0s[top + 1, :] = cm
+                c1s[top + 1, :] = c1_old
+                s1s[top] = sm
+                c1s[top, :] = cm
             top += 2
     return best, best_seg, best_s, min(best - tol, floor)
 

@@ -1,0 +1,1 @@
+"""Stochastic Robustness Analysis of planned paths and planners (issue 18)."""

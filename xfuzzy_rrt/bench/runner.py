@@ -83,11 +83,15 @@ def check_planners(planners: list[str]) -> list[str]:
 def _certify(scenario: Scenario, path: np.ndarray) -> tuple[bool, float]:
     from xfuzzy_rrt.geometry.path_check import certify_path
 
-    check = certify_path(scenario.arrays(), path)
+    from xfuzzy_rrt.geometry.clearance import planning_margin
+
+    check = certify_path(scenario.arrays(), path, planning_margin(scenario))
     return bool(check.certified), float(check.penetration_m)
 
 
 def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
+    from xfuzzy_rrt.geometry.clearance import planning_margin
+
     r = plan_scenario(job.scenario, planner=job.planner, rulebook=job.rulebook, seed=job.seed,
                       max_iter=job.max_iter)
     params = r.params if isinstance(r.params, dict) else {}
@@ -113,7 +117,8 @@ def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
             from xfuzzy_rrt.planners.shortcut import shortcut_path
 
             short = shortcut_path(job.scenario.arrays(), r.path_deg, seed=job.seed,
-                                  attempts=SHORTCUT_ATTEMPTS)
+                                  attempts=SHORTCUT_ATTEMPTS,
+                                  margin=planning_margin(job.scenario))
             row["cost_short_deg"] = path_cost_deg(short)
     elif job.shortcut:
         row["cost_short_deg"] = np.nan

@@ -61,7 +61,8 @@ def _render_summary(summary) -> str:
 
 
 def _run(scenarios: List[Path], planners: str, runs: int, seed: int, rulebook: Optional[Path],
-         max_iter: int, out: Path, workers: int, shortcut: bool = False) -> int:
+         max_iter: int, out: Path, workers: int, shortcut: bool = False,
+         clearance: float | None = None) -> int:
     from xfuzzy_rrt.bench.runner import check_planners, run_benchmark, scenario_files
     from xfuzzy_rrt.cli.common import load_scenario_warn
 
@@ -70,7 +71,9 @@ def _run(scenarios: List[Path], planners: str, runs: int, seed: int, rulebook: O
     if out.exists() and not out.is_dir():  # fail before planning, not after
         raise InputError(str(out), "exists and is not a directory (--out names a folder)")
     names = check_planners([p.strip() for p in planners.split(",") if p.strip()])
-    loaded = [load_scenario_warn(p) for p in scenario_files(scenarios)]
+    from xfuzzy_rrt.geometry.clearance import with_clearance
+
+    loaded = [with_clearance(load_scenario_warn(p), clearance) for p in scenario_files(scenarios)]
     result = run_benchmark(loaded, names, runs=runs, seed=seed, rulebook=rulebook,
                            max_iter=max_iter, workers=workers, shortcut=shortcut,
                            progress=ProgressBar())
@@ -101,10 +104,12 @@ def bench(
     shortcut: bool = typer.Option(False, "--shortcut",
                                   help="Also shorten every path by certified shortcutting "
                                        "(cost_short_deg; cost_deg stays the raw cost)."),
+    clearance: Optional[float] = typer.Option(
+        None, "--clearance", help="Certified clearance in metres (default: each scenario's [safety] clearance_m, else 0)."),
 ) -> int:
     """Benchmark planners: runs.csv, summary.csv, ratios.csv and report.html in the output folder."""
     return _run(scenarios, planners, runs, seed, rulebook, max_iter, out or _default_out("bench"),
-                workers, shortcut)
+                workers, shortcut, clearance)
 
 
 def demo(

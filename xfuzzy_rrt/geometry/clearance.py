@@ -54,6 +54,24 @@ def resolve_clearance(scenario, clearance_m: float | None = None) -> float:
     return check_clearance(own if own is not None else 0.0, where)
 
 
+def with_clearance(scenario, clearance_m: float | None):
+    """``scenario`` with its clearance set to ``clearance_m`` (``None``: unchanged).
+
+    How ``--clearance`` reaches code that only sees scenarios (the bench runner, training):
+    every planner then resolves it from the scenario. Validated here (``--clearance``).
+    """
+    import dataclasses
+
+    if clearance_m is None:
+        return scenario
+    c = check_clearance(clearance_m, "--clearance")
+    if any(f.name == "clearance_m" for f in dataclasses.fields(scenario)):
+        return dataclasses.replace(scenario, clearance_m=c)
+    copy = dataclasses.replace(scenario)  # a Scenario without the field (older model)
+    object.__setattr__(copy, "clearance_m", c)
+    return copy
+
+
 def planning_margin(scenario, clearance_m: float | None = None,
                     margin: float | None = None) -> float:
     """The kernels' ``margin`` for planning ``scenario`` with the clearance in force.
@@ -274,4 +292,5 @@ def path_min_clearance(arrays, path_deg, tol: float = MIN_CLEARANCE_TOL_M,
 
 
 __all__ = ["CERT_MARGIN_M", "MIN_CLEARANCE_TOL_M", "MinClearance", "check_endpoints_keep",
-           "min_clearance_kernel", "path_min_clearance", "planning_margin", "resolve_clearance"]
+           "min_clearance_kernel", "path_min_clearance", "planning_margin", "resolve_clearance",
+           "with_clearance"]

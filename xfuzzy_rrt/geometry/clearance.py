@@ -209,6 +209,7 @@ def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals, d
     c0s = np.empty((cap, nl))
     c1s = np.empty((cap, nl))
     cm = np.empty(nl)
+    c1_old = np.empty(nl)
     q = np.empty(path.shape[1])
     for oi in range(n - 1):
         i = order[oi]
@@ -243,7 +244,8 @@ def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals, d
                 best_seg = i
                 best_s = sm
             # Both halves go on the stack; the one with the smaller bound is explored first.
-            c1_old = c1s[top].copy()
+            for k in range(nl):
+                c1_old[k] = c1s[top, k]
             left = _interval_bound(c0s[top], cm, mk, sm - s0)
             right = _interval_bound(cm, c1_old, mk, s1 - sm)
             if left <= right:

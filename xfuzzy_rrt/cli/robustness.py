@@ -116,8 +116,12 @@ def path_cmd(
     from xfuzzy_rrt.cli.common import load_scenario_warn
     from xfuzzy_rrt.robustness.inputs import load_result_path
 
+    from xfuzzy_rrt.errors import InputError
+
     sigmas = _floats(sigma, "--sigma")
     base = _perturbation(sigma_size, sigma_joint_deg, distribution)
+    if html and out is None:
+        raise InputError("--html", "needs --out (the page is written beside the tables)")
     _check_out(out)
     s = load_scenario_warn(scenario)
     pp = load_result_path(s, result)

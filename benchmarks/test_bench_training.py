@@ -55,3 +55,26 @@ def test_python_api_call_overhead_with_default_rulebook(benchmark, scenario):
     results = benchmark(calls)
     inside = float(np.median([r.wall_s for r in results]))
     benchmark.extra_info["planner_median_ms"] = inside * 1e3
+
+
+def test_one_goal_frame_generation_on_generated_problems(benchmark, scenario):
+    """The goal-frame training's unit of work: 120 individuals x 1 run on 32 problems (the
+    shipped run used 160 problems: five times this). Half the population sits near the shipped
+    goal-frame rulebook, as late in training."""
+    from xfuzzy_rrt.scenarios.generate import generate_one
+
+    problems = [Problem.from_scenario(generate_one(4900, k).scenario) for k in range(32)]
+    config = GAConfig(population=120, bounds="goal-frame", scenarios=(("x", "-"),))
+    rng = np.random.default_rng(0)
+    pop = initial_population(config, rng)
+    shipped = rulebooks_dir() / "goal-frame"
+    if shipped.is_dir():
+        pop[::2] = np.clip(encode(*load_rulebook(shipped).arrays(), "goal-frame")
+                           + 0.01 * rng.standard_normal(pop[::2].shape), 0, 1)
+    seeds = generation_seeds(0, 0, 1)
+    with make_evaluator(problems, "goal-frame", 10_000, workers=os.cpu_count()) as evaluate:
+        evaluate(pop[:4], seeds)
+        t0 = time.perf_counter()
+        benchmark.pedantic(evaluate, args=(pop, seeds), rounds=3, iterations=1)
+        wall = (time.perf_counter() - t0) / 3
+    benchmark.extra_info["runs_per_s"] = 120 * 32 / wall

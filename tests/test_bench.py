@@ -78,7 +78,9 @@ def test_our_planners_paths_are_all_certified_and_shortcuts_never_longer(bench_d
     assert (ok["cost_short_deg"] <= ok["cost_deg"] + 1e-9).all()
     assert ok["cost_short_deg"].lt(ok["cost_deg"] - 1e-6).any(), "shortcutting never shortened"
     failed = result.runs[~result.runs["success"]]
-    assert failed["certified"].isna().all() and failed["cost_short_deg"].isna().all()
+    assert not failed["found"].any() and not failed["certified"].any()
+    assert failed["cost_short_deg"].isna().all() and failed["min_clearance_m"].isna().all()
+    assert (ok["found"] & ok["certified"]).all() and (ok["min_clearance_m"] > 0.0).all()
     assert (ok["time_first_s"] == ok["wall_s"]).all()
     assert (result.summary["certified_fraction"].dropna() == 1.0).all()
 
@@ -180,6 +182,114 @@ def test_bench_json_records_scenario_hashes_and_rulebook(bench_dir):
     assert meta["settings"]["shortcut"] is True and meta["settings"]["max_iter"] == 600
 
 
+@pytest.fixture(scope="module")
+def ompl_bench(scenarios):
+    """RRT and OMPL's RRTConnect on two-circles, seeds 0-5 (seed 4 grazes a circle)."""
+    from xfuzzy_rrt.bench.runner import run_benchmark
+
+    return run_benchmark(scenarios[:1], ["rrt", "ompl:RRTConnect"], runs=6, max_iter=5000,
+                         shortcut=True)
+
+
+def test_ompl_rows_are_certified_exactly_when_the_exact_oracle_finds_no_collision(ompl_bench,
+                                                                                 scenarios):
+    from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
+    from xfuzzy_rrt.geometry.path_check import MIN_CLEARANCE_TOL_M
+    from xfuzzy_rrt.planners.api import plan_scenario
+
+    oracle = Oracle(TWO_CIRCLES)
+    rows = ompl_bench.runs[ompl_bench.runs["planner"] == "ompl:RRTConnect"]
+    assert rows["found"].all()
+    assert not rows["certified"].all(), "fixture: one of these OMPL paths grazes an obstacle"
+    for row in rows.itertuples(index=False):
+        again = plan_scenario(scenarios[0], "ompl:RRTConnect", seed=row.seed, max_iter=5000)
+        assert again.iterations == row.iterations  # the same run, so the same path
+        problems = oracle.path_problems(again.path_deg)
+        dense = float(np.min(oracle.clearance(oracle.densify(again.path_deg, 0.02))))
+        assert row.success == (row.found and row.certified)
+        # The minimum clearance is exact: nothing on the path is closer (0.1 um), and a dense
+        # oracle scan finds it to within its 0.02 deg resolution.
+        assert dense >= row.min_clearance_m - MIN_CLEARANCE_TOL_M
+        assert dense == pytest.approx(row.min_clearance_m, abs=2e-5)
+        assert row.penetration_m == max(0.0, -row.min_clearance_m)
+        if row.certified:
+            assert problems == [] and row.min_clearance_m > CERT_MARGIN_M
+            assert row.cost_short_deg <= row.cost_deg + 1e-9
+        else:
+            assert problems and row.min_clearance_m < 0.0 and not row.success
+            assert np.isnan(row.cost_short_deg), "an uncertified path is never shortened"
+    worst = ompl_bench.worst_examples[("two-circles", "ompl:RRTConnect")]
+    assert worst.min_clearance_m == rows["min_clearance_m"].min() and not worst.certified
+    assert worst.violation.startswith(f"segment ") and "penetrates an obstacle" in worst.violation
+    s = ompl_bench.summary.set_index("planner").loc["ompl:RRTConnect"]
+    assert s["success_rate"] == rows["certified"].mean() < s["found_rate"] == 1.0
+    assert s["certified_fraction"] == rows["certified"].mean()
+    assert s["min_clearance_min_m"] == rows["min_clearance_m"].min() < 0.0
+
+
+def test_ompl_is_compared_on_time_to_first_path_and_ours_on_iterations(ompl_bench, bench_dir):
+    from xfuzzy_rrt.bench.summary import ratio_table
+
+    summary = ompl_bench.summary.set_index("planner")
+    runs = ompl_bench.runs
+
+    def time_median(planner):
+        g = runs[runs["planner"] == planner]
+        return float(np.median(np.where(g["success"], g["time_first_s"], g["wall_s"])))
+
+    assert summary.loc["ompl:RRTConnect", "time_first_median_s"] == time_median("ompl:RRTConnect")
+    expected = time_median("rrt") / time_median("ompl:RRTConnect")
+    assert np.isnan(summary.loc["ompl:RRTConnect", "iter_ratio_vs_rrt"])
+    assert summary.loc["ompl:RRTConnect", "time_ratio_vs_rrt"] == pytest.approx(expected)
+    row = ompl_bench.ratios.set_index("planner").loc["ompl:RRTConnect"]
+    assert row["metric"] == "time_first_s" and row["ratio_median"] == pytest.approx(expected)
+    assert row["ratio_geomean"] == pytest.approx(expected)
+    ours = ratio_table(bench_dir[0].summary).set_index("planner").loc["fuzzy-rrt"]
+    assert ours["metric"] == "iterations"
+    per = bench_dir[0].summary.query("planner == 'fuzzy-rrt'")["iter_ratio_vs_rrt"]
+    assert ours["ratio_geomean"] == pytest.approx(float(np.exp(np.mean(np.log(per)))))
+
+
+def test_several_rulebooks_run_side_by_side_one_row_each(scenarios, tmp_path):
+    import json
+
+    from xfuzzy_rrt.bench.runner import run_benchmark
+    from xfuzzy_rrt.bench.store import load_bench_dir, write_bench_dir
+    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook, rulebooks_dir
+    from xfuzzy_rrt.planners.api import plan_scenario
+
+    mine = tmp_path / "mine"
+    shutil.copytree(rulebooks_dir() / "expert", mine)
+    labels = ["rrt", "fuzzy-rrt", "fuzzy-rrt:paper", f"fuzzy-rrt:{mine}"]
+    result = run_benchmark(scenarios[:1], labels, runs=3, max_iter=3000)
+    assert list(result.summary["planner"]) == labels
+    sha = {"fuzzy-rrt": load_rulebook(default_rulebook_path()).sha256,
+           "fuzzy-rrt:paper": load_rulebook(rulebooks_dir() / "paper").sha256,
+           f"fuzzy-rrt:{mine}": load_rulebook(mine).sha256}
+    assert len(set(sha.values())) == 3
+    for label, digest in sha.items():
+        rows = result.runs[result.runs["planner"] == label]
+        assert len(rows) == 3 and (rows["rulebook_sha256"] == digest).all()
+    paper = result.runs[result.runs["planner"] == "fuzzy-rrt:paper"]
+    direct = [plan_scenario(scenarios[0], "fuzzy-rrt", rulebook=rulebooks_dir() / "paper",
+                            seed=k, max_iter=3000).iterations for k in range(3)]
+    assert list(paper["iterations"]) == direct and (paper["rulebook"] == "paper").all()
+    assert set(result.ratios["planner"]) == set(sha)
+    out = tmp_path / "bench"
+    write_bench_dir(result, out, {"command": "test"})
+    meta = json.loads((out / "bench.json").read_text())
+    assert {e["planner"]: e["sha256"] for e in meta["rulebooks"]} == sha
+    assert {e["planner"]: e["dir"] for e in meta["rulebooks"]}[f"fuzzy-rrt:{mine}"] == str(mine)
+    back = load_bench_dir(out)
+    assert {k: v.sha256 for k, v in back.rulebooks.items()} == sha
+    assert set(back.worst_examples) == set(back.examples)
+    for key, r in result.worst_examples.items():
+        assert back.worst_examples[key].seed == r.seed
+        assert back.worst_examples[key].min_clearance_m == r.min_clearance_m
+    assert set(back.examples) == {("two-circles", p) for p in labels}
+    assert all(back.examples[("two-circles", p)].trace is not None for p in sha)
+
+
 @pytest.mark.skipif(not (SHARED_SCENARIOS / "paper-reference.toml").is_file(),
                     reason="shared scenarios not present")
 def test_ompl_planner_runs_beside_ours_and_its_paths_are_certified_or_flagged(tmp_path):
@@ -193,7 +303,7 @@ def test_ompl_planner_runs_beside_ours_and_its_paths_are_certified_or_flagged(tm
     ompl_rows = result.runs[result.runs["planner"] == "ompl:RRTConnect"]
     assert ompl_rows["success"].any()
     for row in ompl_rows[ompl_rows["success"]].itertuples(index=False):
-        assert row.certified in (True, False)
+        assert row.certified and row.found and row.min_clearance_m > 0.0
         assert row.cost_short_deg <= row.cost_deg + 1e-9
     example = result.examples[("paper-reference", "ompl:RRTConnect")]
     problems = oracle.path_problems(example.path_deg)

@@ -8,9 +8,12 @@ from conftest import FIXTURES
 from xfuzzy_rrt.analysis.firing import rule_influence, top_rules
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
-from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, OUTPUTS
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
+
+
+OUTPUTS = load_rulebook(default_rulebook_path()).outputs  # the default rulebook's semantics
 
 
 @pytest.fixture(scope="module")

@@ -411,7 +411,10 @@ EDGE_CASES += [
     ("limits-empty", {"limits": "[]"}, "reject:arm.joint_limits_deg: must have one"),
     ("center-empty", {"obstacles": '[[obstacles]]\ntype = "circle"\ncenter = []\nradius = 0.1\n'},
      "reject:obstacles[0].center: must have 2 numbers"),
-    ("obstacles-empty", {"obstacles": "obstacles = []"}, "accept"),
+    # after the [goal] header this key belongs to [goal]: a misplaced key is an error, not
+    # silently ignored (an explicit top-level 'obstacles = []' is accepted: test_scenario_loading)
+    ("obstacles-key-inside-goal", {"obstacles": "obstacles = []"},
+     "reject:unknown key 'obstacles' in [goal]"),
     ("links-1e-9", {"links": "[1e-9, 1e-9]", "link_radius": "0.0"}, "accept"),
     ("start-on-joint-limits", {"start": "[-170.0, 160.0]", "goal": "[170.0, -160.0]",
                                "obstacles": circles([(0.0, 0.5, 0.05)])}, "accept"),

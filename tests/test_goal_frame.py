@@ -141,6 +141,30 @@ def test_goal_frame_trace_explains_every_decision_with_the_traced_numbers():
         assert [s.output for s in e.systems] == list(GF.outputs)
 
 
+def test_samples_lie_in_the_goal_frame_box_laid_along_the_direction_to_the_goal():
+    rb = _rulebook(values=(0.1, 0.3, 50.0, 10.0, 20.0, 8.0))
+    sc = load_scenario(SCENARIOS[0])
+    t = plan_fuzzy_rrt(sc, rulebook=rb, seed=2, trace=True).trace
+    goal = np.array(sc.goal_deg)
+    box = t[~t["goal_sampled"]]
+    full = (box["box_q1_lo"] == -180) & (box["box_q1_hi"] == 180) & (box["box_q2_lo"] == -180)
+    assert 0 < full.mean() < 1  # uniform samples (whole joint space) and goal-frame boxes
+    framed = box[~full]
+    q = framed[["from_q1_deg", "from_q2_deg"]].to_numpy()
+    s = framed[["sample_q1_deg", "sample_q2_deg"]].to_numpy()
+    e = goal - q
+    e /= np.linalg.norm(e, axis=1, keepdims=True)
+    along = ((s - q) * e).sum(axis=1)
+    across = (s - q)[:, 0] * -e[:, 1] + (s - q)[:, 1] * e[:, 0]
+    inside = (s > -180) & (s < 180)  # clamping moves a sample onto a limit, out of the frame
+    ok = inside.all(axis=1)
+    assert ok.mean() > 0.5
+    assert (along[ok] >= -10.0 - 1e-9).all() and (along[ok] <= 50.0 + 1e-9).all()
+    assert (np.abs(across[ok]) <= 20.0 + 1e-9).all()
+    for c, lo, hi in (("sample_q1_deg", "box_q1_lo", "box_q1_hi"), ("sample_q2_deg", "box_q2_lo", "box_q2_hi")):
+        assert (framed[c] >= framed[lo] - 1e-9).all() and (framed[c] <= framed[hi] + 1e-9).all()
+
+
 def test_clearance_input_is_a_certified_free_radius_in_joint_space():
     """Within clearance_deg of a node every configuration is collision-free (sampled check)."""
     rb = _rulebook()
@@ -257,3 +281,21 @@ def test_protocol_rejects_an_unknown_rulebook_with_one_line(run_cli):
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
         "error: --rulebook: 'no-such-rulebook' is neither a shipped rulebook nor a directory"]
+
+
+def test_rule_analysis_tools_work_on_goal_frame_rulebooks(tmp_path, run_cli):
+    save_rulebook(_rulebook(jitter=0.05, seed=8), tmp_path / "gf")
+    proc = run_cli("rules", "coverage", tmp_path / "gf", SCENARIOS[0], "--runs", "3",
+                   "--out", tmp_path / "cov.csv")
+    assert proc.returncode == 0, proc.stderr
+    cov = pd.read_csv(tmp_path / "cov.csv")
+    assert set(cov["output"]) == set(GF.outputs) and len(cov) == 6 * 625
+    proc = run_cli("rules", "simplify", tmp_path / "gf", "--out", tmp_path / "simple")
+    assert proc.returncode == 0, proc.stderr
+    assert load_rulebook(tmp_path / "simple").semantics is GF
+    proc = run_cli("rules", "diff", tmp_path / "gf", tmp_path / "simple")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    proc = run_cli("rules", "show", tmp_path / "gf", "--when", "stagnation=stuck,reject_rate=blocked")
+    assert proc.returncode == 0 and "uniform_share" in proc.stdout
+    proc = run_cli("rules", "show", tmp_path / "gf", "--when", "dist_to_goal=near")
+    assert proc.returncode == 2 and "unknown input 'dist_to_goal'" in proc.stderr

@@ -47,7 +47,7 @@ def test_engine_outputs_of_shipped_rulebooks_match_golden_file(name):
 
 def test_golden_plans_cover_rrt_and_every_shipped_rulebook():
     assert set(PLANS["planner"]) == {"rrt", "fuzzy-rrt"}
-    assert {"paper", "expert", "general"} <= set(PLANS["rulebook"])
+    assert {"paper", "expert", "general", "goal-frame"} <= set(PLANS["rulebook"])
     assert set(PLANS["seed"]) == set(range(5))
 
 

@@ -14,6 +14,7 @@ the interruption and ends with exactly the rulebook an uninterrupted run writes.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import subprocess
@@ -71,51 +72,59 @@ def snapshot(folder: Path) -> dict[str, bytes]:
 
 
 # --------------------------------------------------------------------------------- bench
+#
+# A bench folder is written into a hidden sibling and swapped in as a whole, so whatever the
+# moment of an interruption the folder is byte for byte the previous complete one (or absent).
+# The moments are hit deterministically through the CLI's test hook
+# (``XFUZZY_RRT_TEST_SIGNAL=SIG@POINT``: after run K, after the tables, after the report), not by
+# polling; SIGINT goes to the whole process group, as a terminal's Ctrl-C does, so worker
+# processes receive it too.
 
 BENCH_FILES = ["runs.csv", "summary.csv", "ratios.csv", "bench.json", "report.html",
                "examples/index.json"]
+BENCH_RUNS = 3
 
 
-def bench_args(out: Path, runs: int) -> list[str]:
-    return ["bench", str(SCENARIO), "--planners", "rrt", "--runs", str(runs), "--workers", "1",
-            "--max-iter", "3000", "--out", str(out)]
+def bench_args(out: Path, runs: int, workers: int = 1) -> list[str]:
+    return ["bench", str(SCENARIO), "--planners", "rrt,fuzzy-rrt", "--runs", str(runs),
+            "--workers", str(workers), "--max-iter", "3000", "--out", str(out)]
 
 
-def assert_complete_bench_file(path: Path, name: str, runs_options: set[int]) -> None:
-    """``path`` is a whole output file of a bench with one of ``runs_options`` runs."""
-    if name == "runs.csv":
-        assert len(pd.read_csv(path)) in runs_options, f"{name}: rows missing"
-    elif name in ("summary.csv",):
-        df = pd.read_csv(path)
-        assert len(df) == 1 and int(df["runs"].iloc[0]) in runs_options
-    elif name == "ratios.csv":
-        path.read_text().encode()  # may legitimately be empty for one planner
-    elif name.endswith(".json"):
-        json.loads(path.read_text())
-    elif name == "report.html":
-        assert path.read_text().rstrip().endswith("</html>"), "report.html is truncated"
-    elif name.endswith(".parquet"):
-        pd.read_parquet(path)
+def run_with_hook(args: list[str], hook: str) -> subprocess.CompletedProcess:
+    """Run ``xfuzzy-rrt ARGS`` in its own process group with the test hook set."""
+    env = dict(os.environ, XFUZZY_RRT_TEST_SIGNAL=hook)
+    return subprocess.run([console_script(), *map(str, args)], capture_output=True, text=True,
+                          timeout=TIMEOUT_S, env=env, start_new_session=True)
 
 
-def check_bench_folder(out: Path, before: dict[str, bytes], runs_options: set[int]) -> None:
-    after = snapshot(out)
-    for name in sorted(set(before) | set(after)):
-        if name not in after:
-            pytest.fail(f"{name} of the previous complete run disappeared")
-        if name in before and after[name] == before[name]:
-            continue  # the previous complete file, untouched
-        assert_complete_bench_file(out / name, name, runs_options)
+def check_bench_folder(out: Path, runs: int) -> None:
+    """Every file present, complete and consistent with the others."""
+    from xfuzzy_rrt.bench.store import read_runs
+    from xfuzzy_rrt.bench.summary import ratio_table, summarise
+
     for name in BENCH_FILES:
-        assert name in after, f"{name} missing"
+        assert (out / name).is_file(), f"{name} missing"
+    runs_df = read_runs(out / "runs.csv")
+    assert len(runs_df) == 2 * runs and (runs_df.groupby("planner").size() == runs).all()
+    summary = pd.read_csv(out / "summary.csv")
+    pd.testing.assert_frame_equal(summarise(runs_df).reset_index(drop=True), summary,
+                                  check_dtype=False)
+    ratios = pd.read_csv(out / "ratios.csv")
+    assert list(ratios["planner"]) == ["fuzzy-rrt"], "ratios.csv is incomplete"
+    pd.testing.assert_frame_equal(ratio_table(summary), ratios, check_dtype=False)
+    meta = json.loads((out / "bench.json").read_text())
+    assert meta["settings"]["runs"] == runs
+    index = json.loads((out / "examples" / "index.json").read_text())
+    assert {e["planner"] for e in index} == {"rrt", "fuzzy-rrt"}
+    for e in index:
+        pd.read_parquet(out / "examples" / e["tree"])
+        if e["trace"]:
+            pd.read_parquet(out / "examples" / e["trace"])
+    assert (out / "report.html").read_text().rstrip().endswith("</html>")
 
 
-def _seen_temp(out: Path, part: str = ""):
-    return lambda _stderr: any(part in p.name for p in temp_files(out))
-
-
-def _planning(_out: Path):
-    return lambda stderr: "bench:" in stderr or "runs" in stderr
+def staging_dirs(parent: Path) -> list[Path]:
+    return [p for p in parent.iterdir() if p.name.endswith((".staging", ".old"))]
 
 
 @pytest.fixture(scope="module")
@@ -125,42 +134,51 @@ def previous_bench(tmp_path_factory):
     proc = subprocess.run([console_script(), *bench_args(out, 1)], capture_output=True,
                           text=True, timeout=TIMEOUT_S)
     assert proc.returncode == 0, proc.stderr
-    assert temp_files(out) == []
+    check_bench_folder(out, 1)
     return out
 
 
-@pytest.mark.parametrize("sig,moment", [
-    (signal.SIGINT, "planning"),
-    (signal.SIGINT, "report"),
-    (signal.SIGKILL, "planning"),
-    (signal.SIGKILL, "first-write"),
-    (signal.SIGKILL, "report"),
+@pytest.mark.parametrize("sig,point,workers", [
+    ("INT", "runs:2", 2),
+    ("INT", "runs:2", 1),
+    ("INT", "tables", 1),
+    ("INT", "report", 2),
+    ("KILL", "runs:2", 2),
+    ("KILL", "tables", 1),
+    ("KILL", "report", 1),
 ])
-def test_interrupted_bench_leaves_the_previous_complete_output_or_a_complete_new_one(
-        run_cli, tmp_path, previous_bench, sig, moment):
+def test_interrupted_bench_leaves_the_previous_complete_folder_byte_for_byte(
+        run_cli, tmp_path, previous_bench, sig, point, workers):
     out = tmp_path / "bench"
     shutil.copytree(previous_bench, out)
     before = snapshot(out)
-
-    trigger = {"planning": _planning(out), "first-write": _seen_temp(out),
-               "report": _seen_temp(out, "report.html")}[moment]
-    code, err, interrupted = run_interrupted(bench_args(out, 2), sig, trigger, tmp_path / "logs")
-    assert interrupted, f"the bench finished before the {moment!r} trigger: {err}"
-    if sig == signal.SIGINT:
-        assert code == 130, err
-        assert "Traceback" not in err, err
-        assert temp_files(out) == [], "SIGINT left temporary files"
+    proc = run_with_hook(bench_args(out, BENCH_RUNS, workers), f"{sig}@{point}")
+    if sig == "INT":
+        assert proc.returncode == 130, proc.stderr
+        assert "Traceback" not in proc.stderr and "KeyboardInterrupt" not in proc.stderr
+        lines = [ln for ln in proc.stderr.splitlines() if "interrupted" in ln]
+        assert lines == [f"interrupted: {out}: the previous folder is unchanged"], proc.stderr
+        assert staging_dirs(tmp_path) == [], "Ctrl-C left the hidden staging folder"
     else:
-        assert code == -signal.SIGKILL
-        # A killed process cannot clean up; its temporaries never carry an output's name.
-        assert all(p.name.startswith(".") for p in temp_files(out))
-    check_bench_folder(out, before, runs_options={1, 2})
-    if sig == signal.SIGKILL and moment == "report":
-        # The next run over a folder a killed run left behind completes normally.
-        again = run_cli(*bench_args(out, 2), timeout=TIMEOUT_S)
-        assert again.returncode == 0, again.stderr
-        check_bench_folder(out, snapshot(out), runs_options={2})
-        assert len(pd.read_csv(out / "runs.csv")) == 2
+        # Returning at all shows the workers died with the parent: an orphan would hold the
+        # output pipes open and time this call out.
+        assert proc.returncode == -signal.SIGKILL
+        # A killed process cannot clean up: its staging folder stays hidden beside ``out``.
+        assert all(p.name.startswith(".") for p in staging_dirs(tmp_path))
+    assert snapshot(out) == before, "the previous complete folder changed"
+    check_bench_folder(out, 1)
+    # The next bench into the same folder completes and replaces it as a whole.
+    again = run_cli(*bench_args(out, BENCH_RUNS, workers), timeout=TIMEOUT_S)
+    assert again.returncode == 0, again.stderr
+    check_bench_folder(out, BENCH_RUNS)
+
+
+def test_interrupted_first_bench_leaves_no_folder(tmp_path):
+    out = tmp_path / "new" / "bench"
+    proc = run_with_hook(bench_args(out, BENCH_RUNS, 2), "INT@runs:1")
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr.splitlines()[-1] == f"interrupted: {out}: nothing was written"
+    assert not (tmp_path / "new").exists() and staging_dirs(tmp_path) == []
 
 
 # --------------------------------------------------------------------------------- train

@@ -51,7 +51,7 @@ def test_sha256_is_over_the_canonical_file_bytes(tmp_path):
     import hashlib
 
     h = hashlib.sha256()
-    for name in [MANIFEST_NAME] + [f"{o}.fis" for o in OUTPUTS]:
+    for name in [MANIFEST_NAME] + [f"{o}.fis" for o in rb.outputs]:
         data = (default_rulebook_path() / name).read_bytes()
         h.update(f"{name}\n{len(data)}\n".encode())
         h.update(data)
@@ -156,8 +156,10 @@ def test_save_keeps_unrelated_files(tmp_path):
 
 
 def test_env_var_overrides_the_rulebooks_folder(tmp_path, monkeypatch):
-    copy_expert(tmp_path, "general")
+    from xfuzzy_rrt.fuzzy.rulebook import DEFAULT_RULEBOOK
+
+    copy_expert(tmp_path, DEFAULT_RULEBOOK)
     copy_expert(tmp_path, "other")
     monkeypatch.setenv("XFUZZY_RRT_RULEBOOKS", str(tmp_path))
-    assert default_rulebook_path() == tmp_path / "general"
-    assert [p.name for p in list_rulebooks()] == ["general", "other"]
+    assert default_rulebook_path() == tmp_path / DEFAULT_RULEBOOK
+    assert [p.name for p in list_rulebooks()] == sorted([DEFAULT_RULEBOOK, "other"])

@@ -102,7 +102,7 @@ def test_quantise_uses_at_most_k_levels_within_range():
     assert np.max(np.abs(q - v)) < 90
 
 
-def test_budgeted_simplify_claimed_loss_is_remeasured_and_holds(tmp_path):
+def test_budgeted_simplify_claimed_loss_is_remeasured_and_holds_and_rechecked_on_fresh_seeds(tmp_path):
     rb = load_rulebook(EXPERT)
     scen = load_scenario(DEMO)
     res = simplify(rb, budget="iterations+10%", scenarios=[scen], seeds=4, max_iter=2000,
@@ -121,6 +121,17 @@ def test_budgeted_simplify_claimed_loss_is_remeasured_and_holds(tmp_path):
     prov = thaw(back.provenance)
     assert prov["measured_loss"] == pytest.approx(measured, abs=1e-12)
     assert prov["source_sha256"] == rb.sha256 and prov["budget"] == "iterations+10%"
+    # the search chose on seeds 0..3: the loss is measured again on seeds it never ran
+    assert res.holdout_seeds == (4, 7)
+    base_h = [plan_scenario(scen, "fuzzy-rrt", rulebook=rb, seed=s, max_iter=2000).iterations
+              for s in range(4, 8)]
+    new_h = [plan_scenario(scen, "fuzzy-rrt", rulebook=back, seed=s, max_iter=2000).iterations
+             for s in range(4, 8)]
+    fresh = (np.mean(new_h) - np.mean(base_h)) / np.mean(base_h)
+    assert res.holdout_loss == pytest.approx(fresh, abs=1e-12)
+    assert res.holdout_within_budget == (fresh <= 0.10 + 1e-9)
+    assert prov["holdout_loss"] == pytest.approx(fresh, abs=1e-12)
+    assert prov["holdout_seeds"] == "4..7"
 
 
 def test_adjacent_jaccard_matches_numeric_integration():

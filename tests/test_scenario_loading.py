@@ -33,12 +33,64 @@ def test_model_is_frozen():
         s.name = "other"  # type: ignore[misc]
 
 
-def test_unknown_keys_are_recorded_not_fatal(tmp_path):
-    text = (FIXTURES / "scenarios" / "empty.toml").read_text().replace(
-        "[arm]", "seed = 3\n[arm]\nlinkz = 1")
+def _with(tmp_path, old: str, new: str, source: str = "two-circles.toml"):
+    text = (FIXTURES / "scenarios" / source).read_text()
+    assert old in text
     p = tmp_path / "typo.toml"
-    p.write_text(text)
-    assert set(load_scenario(p).unknown_keys) == {"seed", "arm.linkz"}
+    p.write_text(text.replace(old, new, 1))
+    return p
+
+
+# (replace this, by this) -> the line and the message the error must give
+UNKNOWN_KEY_CASES = [
+    # the case: a typo in an array-of-tables header used to delete every obstacle
+    ("[[obstacles]]", "[[obstacle]]", 10,
+     "unknown key 'obstacle' (did you mean '[[obstacles]]'?)"),
+    ("links = [0.2, 0.1]", "linkz = [0.2, 0.1]", 4,
+     "unknown key 'linkz' in [arm] (did you mean 'links'?)"),
+    ("radius = 0.05", "raduis = 0.05", 17, "unknown key 'raduis' in [[obstacles]] #2"),
+    ("[goal]", "[gaol]", 8, "unknown key 'gaol' (did you mean '[goal]'?)"),
+    ("[arm]", "seed = 3\n[arm]", 3, "unknown key 'seed' (known: name, description, [arm]"),
+    ("[start]", "[safety]\nclearance = 0.002\n[start]", 7,
+     "unknown key 'clearance' in [safety] (did you mean 'clearance_m'?)"),
+]
+
+
+@pytest.mark.parametrize("old,new,line,message", UNKNOWN_KEY_CASES,
+                         ids=[c[1].split("\n")[0] for c in UNKNOWN_KEY_CASES])
+def test_unknown_key_is_an_error_with_line_and_nearest_name(tmp_path, old, new, line, message):
+    p = _with(tmp_path, old, new)
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(p)
+    assert str(info.value).startswith(f"{p}:{line}: "), str(info.value)
+    assert message in str(info.value)
+
+
+def test_unknown_table_fails_plan_with_one_line_exit_2(run_cli, tmp_path):
+    p = _with(tmp_path, "[[obstacles]]", "[[obstacle]]")
+    out = tmp_path / "result.json"
+    proc = run_cli("plan", p, "--planner", "rrt", "--out", out)
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        f"error: {p}:10: unknown key 'obstacle' (did you mean '[[obstacles]]'?)"]
+    assert not out.exists()
+
+
+def test_an_explicit_empty_obstacle_list_is_accepted(tmp_path):
+    text = (FIXTURES / "scenarios" / "empty.toml").read_text()
+    p = tmp_path / "explicit.toml"
+    p.write_text("obstacles = []\n" + text)
+    assert load_scenario(p).obstacles == ()
+
+
+def test_safety_clearance_is_validated_and_defaults_to_zero(tmp_path):
+    assert load_scenario(FIXTURES / "scenarios" / "two-circles.toml").clearance_m == 0.0
+    ok = _with(tmp_path, "[start]", "[safety]\nclearance_m = 0.003\n[start]")
+    assert load_scenario(ok).clearance_m == 0.003
+    for bad, expected in (("-0.001", "must be >= 0"), ('"3 mm"', "must be a number")):
+        p = _with(tmp_path, "[start]", f"[safety]\nclearance_m = {bad}\n[start]")
+        with pytest.raises(ScenarioError, match=f"safety.clearance_m: {expected}"):
+            load_scenario(p)
 
 
 # (fixture file, the key or location the one-line error must name)

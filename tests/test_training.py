@@ -221,6 +221,133 @@ def test_bad_training_options_are_one_line_errors(tmp_path):
     assert not (tmp_path / "rb").exists()
 
 
+def test_seed_rulebooks_are_part_of_the_fingerprint_and_must_match_it():
+    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+
+    expert = load_rulebook(rulebooks_dir() / "expert")
+    base = GAConfig(population=12, bounds="relative", scenarios=(("a", "b"),))
+    seeded = GAConfig(population=12, bounds="relative", scenarios=(("a", "b"),),
+                      seed_rulebooks=((expert.name, expert.sha256),))
+    assert base.fingerprint() != seeded.fingerprint()
+    rng = lambda: np.random.default_rng(0)  # noqa: E731
+    pop = initial_population(seeded, rng(), [expert])
+    assert not np.array_equal(pop, initial_population(base, rng()))
+    with pytest.raises(ValueError, match="not the configuration's"):
+        initial_population(seeded, rng())  # the recorded seed is not given: refuse
+    with pytest.raises(ValueError, match="not the configuration's"):
+        initial_population(base, rng(), [expert])  # an unrecorded seed: refuse
+
+
+def test_a_missing_or_mismatched_seed_rulebook_is_an_error_before_any_output(tmp_path):
+    proc = _train(tmp_path, "--seed-rulebook", "nowhere")
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == ["error: nowhere: rulebook directory does not exist"]
+    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+
+    paper = rulebooks_dir() / "paper"  # absolute bounds; the run asks for relative
+    proc = _train(tmp_path, "--seed-rulebook", str(paper))
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        f"error: {paper}: seed rulebook has absolute bounds, but --bounds is relative"]
+    proc = _train(tmp_path, "--init", "random", "--seed-rulebook", str(paper))
+    assert proc.returncode == 2 and proc.stderr.startswith("error: --seed-rulebook: ")
+    # the default seed hidden (it used to be dropped silently, same recorded command)
+    empty = tmp_path / "no-rulebooks"
+    empty.mkdir()
+    proc = subprocess.run(_args(), cwd=tmp_path, capture_output=True, text=True,
+                          env={**os.environ, "XFUZZY_RRT_RULEBOOKS": str(empty)})
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        f"error: {empty / 'expert'}: the default seed rulebook 'expert' is missing; pass "
+        "--seed-rulebook DIR or --init random"]
+    assert not (tmp_path / "rb").exists()
+
+
+def test_an_explicit_seed_rulebook_is_in_the_reproduce_command():
+    from xfuzzy_rrt.training.run import canonical_command
+
+    config = GAConfig(scenarios=(("a", "b"),))
+    cmd = canonical_command(config, ["s.toml"], "out", ["my seeds/expert"])
+    assert "--seed-rulebook 'my seeds/expert'" in cmd
+    assert "--seed-rulebook" not in canonical_command(config, ["s.toml"], "out")
+
+
+def test_workers_0_is_rejected_before_any_folder_is_made(tmp_path):
+    proc = _train(tmp_path, "--workers", "0")
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == ["error: --workers: must be >= 1, got 0"]
+    assert not (tmp_path / "rb").exists()
+
+
+def test_a_bad_scheduler_fails_fast_with_one_line_and_no_folder(tmp_path):
+    pytest.importorskip("distributed")
+    import socket
+
+    from xfuzzy_rrt.errors import InputError
+    from xfuzzy_rrt.training.workers import check_scheduler_address
+
+    with socket.socket() as sock:  # a port where nothing listens
+        sock.bind(("127.0.0.1", 0))
+        closed = f"tcp://127.0.0.1:{sock.getsockname()[1]}"
+    for address, expected in (("nonsense", "'nonsense' is not a scheduler address"),
+                              (closed, f"cannot reach a Dask scheduler at {closed!r}")):
+        started = time.monotonic()
+        with pytest.raises(InputError, match=expected):
+            check_scheduler_address(address)
+        assert time.monotonic() - started <= 5.0  # the issue: it hung 20 s
+        proc = _train(tmp_path, "--scheduler", address, timeout=60)
+        assert proc.returncode == 2
+        lines = proc.stderr.splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error: --scheduler: "), proc.stderr
+        assert expected in lines[0]
+        assert not (tmp_path / "rb").exists()
+
+
+def _children(pid: int) -> list[int]:
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_workers_die_with_a_killed_training_process(tmp_path):
+    proc = subprocess.Popen(_args("--workers", "2", "--population", "200", "--generations", "50"),
+                            cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    workers: list[int] = []
+    try:
+        deadline = time.monotonic() + 120
+        while len(workers) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)  # waiting for a state, not racing one: the workers must exist
+            workers = _children(proc.pid)
+        assert len(workers) == 2, "the training did not start its two workers"
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 10
+        while any(_alive(w) for w in workers) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(_alive(w) for w in workers), "orphaned workers outlived kill -9"
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        for w in workers:  # only the processes this test started
+            if _alive(w):
+                os.kill(w, signal.SIGKILL)
+
+
 def test_trained_rulebook_lints_round_trips_and_records_its_provenance(tmp_path, run_cli):
     proc = _train(tmp_path, "--workers", "1")
     assert proc.returncode == 0, proc.stderr
@@ -233,6 +360,19 @@ def test_trained_rulebook_lints_round_trips_and_records_its_provenance(tmp_path,
     assert [s["sha256"] for s in prov["scenarios"]] == [
         __import__("hashlib").sha256(p.read_bytes()).hexdigest() for p in SCENARIOS]
     assert prov["package_version"] and prov["history"] == "history.csv"
+    # the first generation started from the packaged expert (relative bounds): recorded
+    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+
+    expert = load_rulebook(rulebooks_dir() / "expert")
+    assert [dict(x) for x in prov["seed_rulebooks"]] == [
+        {"name": "expert", "source": "packaged", "sha256": expert.sha256}]
+    import numba
+    import scipy
+
+    assert prov["versions"]["numpy"] == np.__version__
+    assert prov["versions"]["numba"] == numba.__version__
+    assert prov["versions"]["scipy"] == scipy.__version__
+    assert set(prov["versions"]) == {"python", "numpy", "numba", "pymoo", "scipy"}
     # text round trip: save and reload gives the same bytes and rulebook
     save_rulebook(rb, tmp_path / "copy")
     for name in ["rulebook.toml", *(o + ".fis" for o in OUTPUTS)]:
@@ -260,8 +400,7 @@ def test_generated_scenarios_are_valid_solvable_nontrivial_and_deterministic(tmp
     assert len(files) == 3
     for f in files:
         assert f.read_bytes() == (tmp_path / "b" / f.name).read_bytes()
-        s = load_scenario(f)  # the project's own validating loader
-        assert not s.unknown_keys
+        s = load_scenario(f)  # the project's own validating (and strict) loader
         a = s.arrays()
         assert not segment_free(a, a.start_deg, a.goal_deg)  # non-trivial
         assert 2 <= len(s.obstacles) <= 7 and s.arm.dof == 2
@@ -275,7 +414,7 @@ def test_generated_scenarios_are_valid_solvable_nontrivial_and_deterministic(tmp
 def test_default_rulebook_is_parsed_once_while_unchanged(tmp_path, monkeypatch):
     import xfuzzy_rrt.fuzzy.rulebook as rbmod
 
-    shutil.copytree(rbmod.default_rulebook_path(), tmp_path / "rb")
+    shutil.copytree(rbmod.rulebooks_dir() / "general", tmp_path / "rb")  # edits step_size.fis
     calls = []
     real = rbmod.load_rulebook
     monkeypatch.setattr(rbmod, "load_rulebook", lambda p: calls.append(p) or real(p))
@@ -293,6 +432,31 @@ def test_default_rulebook_is_parsed_once_while_unchanged(tmp_path, monkeypatch):
     fis.write_text(text)
     plan_fuzzy_rrt(s, tmp_path / "rb", seed=1)
     assert len(calls) == 2  # an edited file is re-read
+
+
+def test_a_same_size_edit_with_the_old_mtime_is_not_served_from_the_cache(tmp_path):
+    # cp -p, rsync -t and tar x restore timestamps: only the bytes tell the edit apart
+    import re
+
+    import xfuzzy_rrt.fuzzy.rulebook as rbmod
+
+    root = tmp_path / "rb"
+    shutil.copytree(rbmod.rulebooks_dir() / "general", root)  # edits step_size.fis
+    fis = root / "step_size.fis"
+    before = rbmod.load_rulebook_cached(root)
+    st_before = fis.stat()
+    text = fis.read_text()
+    old = re.search(r"r0: .* then step_size = (\S+)", text).group(1)
+    new = old[:-1] + ("1" if old[-1] != "1" else "2")  # same length, another value
+    edited = text.replace(f"then step_size = {old}\n", f"then step_size = {new}\n", 1)
+    assert edited != text and len(edited) == len(text)
+    fis.write_text(edited)
+    os.utime(fis, ns=(st_before.st_atime_ns, st_before.st_mtime_ns))
+    assert fis.stat().st_size == st_before.st_size
+    assert fis.stat().st_mtime_ns == st_before.st_mtime_ns
+    after = rbmod.load_rulebook_cached(root)
+    assert after is not before
+    assert after.sha256 == rbmod.load_rulebook(root).sha256 != before.sha256
 
 
 def test_resuming_a_finished_run_with_more_generations_equals_the_longer_run(tmp_path):
@@ -334,3 +498,41 @@ def test_every_damaged_checkpoint_byte_is_caught_or_harmless(tmp_path):
         else:  # the damage hit bytes nothing reads (e.g. zip comments): same state
             assert np.array_equal(loaded.population, state.population)
             assert loaded.rng_state == state.rng_state
+
+
+def test_a_checkpoint_with_an_unknown_array_or_meta_key_is_refused(tmp_path):
+    import io
+    import json
+
+    from xfuzzy_rrt.errors import InputError
+    from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
+    from xfuzzy_rrt.training.ga import new_state
+
+    config = GAConfig(population=4, elite=1, scenarios=(("a", "b"),))
+    path = save_checkpoint(tmp_path, new_state(config), config)
+
+    def rewrite(change) -> None:
+        with np.load(io.BytesIO(path.read_bytes()), allow_pickle=False) as z:
+            arrays = {name: z[name] for name in z.files}
+        change(arrays)
+        with open(path, "wb") as fh:
+            np.savez(fh, **arrays)
+
+    good = path.read_bytes()
+    rewrite(lambda a: a.update(populaton=a["population"]))
+    with pytest.raises(InputError, match=r"unknown key 'populaton' in the arrays \(did you mean "
+                                         r"'population'\?\)"):
+        load_checkpoint(tmp_path, config)
+
+    path.write_bytes(good)
+
+    def add_meta_key(a):
+        meta = json.loads(str(a["meta"][()]))
+        meta["generations"] = 3
+        a["meta"] = np.array(json.dumps(meta))
+
+    rewrite(add_meta_key)
+    with pytest.raises(InputError) as info:
+        load_checkpoint(tmp_path, config)
+    assert str(info.value) == (f"{path}: unknown key 'generations' in meta "
+                               f"(did you mean 'generation'?)")

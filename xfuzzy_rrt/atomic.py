@@ -19,10 +19,13 @@ def atomic_path(dest: str | os.PathLike[str], suffix: str | None = None) -> Iter
     """Yield a temporary path beside *dest*; move it onto *dest* only if the block succeeds."""
     dest = Path(dest)
     dest.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{dest.name}.", suffix=suffix if suffix is not None else dest.suffix + ".tmp",
-        dir=dest.parent,
-    )
+    try:
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{dest.name}.", suffix=suffix if suffix is not None else dest.suffix + ".tmp",
+            dir=dest.parent,
+        )
+    except OSError as exc:  # name the caller's file, not the hidden temporary one
+        raise OSError(exc.errno, exc.strerror, str(dest)) from None
     os.close(fd)
     tmp_path = Path(tmp)
     # mkstemp creates 0600 files; give outputs the usual permissions (respecting the umask).

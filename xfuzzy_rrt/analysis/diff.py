@@ -145,12 +145,17 @@ class ReplayDiff:
 PLAN_COLUMNS = ["goal_sampled", "sample_q1_deg", "sample_q2_deg", "outcome", "new_node"]
 
 
-def first_divergence(ta: pd.DataFrame, tb: pd.DataFrame, columns=DECISION_COLUMNS) -> int | None:
+def first_divergence(ta: pd.DataFrame, tb: pd.DataFrame, columns=None) -> int | None:
     """First 1-based iteration where the decisions of two traces differ (None: never).
 
-    When one trace is a prefix of the other (one run stopped earlier), the divergence is the
-    first iteration past the shorter one.
+    A decision is the six outputs (named by the traces' semantics) and DECISION_COLUMNS. When
+    one trace is a prefix of the other (one run stopped earlier), the divergence is the first
+    iteration past the shorter one.
     """
+    if columns is None:
+        from xfuzzy_rrt.fuzzy import semantics as _sem
+
+        columns = [*_sem.of_columns(ta.columns).outputs, *DECISION_COLUMNS]
     n = min(len(ta), len(tb))
     for c in columns:
         if c not in ta.columns or c not in tb.columns:

@@ -159,8 +159,11 @@ def explain_row(row: pd.Series, rulebook) -> Explanation:
 
 def render_text(e: Explanation) -> str:
     """A plain-text rendering (what ``xfuzzy-rrt explain`` prints)."""
-    lines = [f"Iteration {e.iteration} — rulebook {e.rulebook!r} (bounds: {e.bounds_mode})", "",
-             "Inputs (measured from the end effector of the current node; clamped to the ranges):"]
+    where = ("measured from the end effector of the current node" if e.bounds_mode
+             else "measured at the current node in joint space")
+    lines = [f"Iteration {e.iteration} — rulebook {e.rulebook!r} "
+             f"({'bounds: ' + e.bounds_mode if e.bounds_mode else 'goal-frame semantics'})", "",
+             f"Inputs ({where}; clamped to the ranges):"]
     for name in e.inputs:
         raw, c = e.inputs[name], e.clamped_inputs[name]
         note = "" if raw == c else f" (measured {raw!r}, clamped)"

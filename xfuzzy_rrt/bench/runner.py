@@ -5,15 +5,24 @@ so they can be spread over worker processes: results are collected in job order,
 every column except the wall-clock ones identical whatever the number of workers. Column names
 are the stable ones of SPEC.md (OMPL-style: one typed row per run).
 
-Every returned path -- ours or an OMPL planner's -- is re-checked with the certified edge
-check (``certified``, ``penetration_m``), and with ``shortcut=True`` shortened by the same
-certified shortcutting pass seeded with the run's seed (``cost_short_deg``; ``cost_deg`` stays
-the raw cost). Both happen inside the worker, so they parallelise with the planning.
+Every returned path -- ours or an OMPL planner's -- is certified by the planner API itself
+(``found``, ``certified``, ``min_clearance_m``, ``penetration_m``; ``success`` is ``found and
+certified``), and with ``shortcut=True`` a *certified* path is shortened by the same certified
+shortcutting pass seeded with the run's seed (``cost_short_deg``; ``cost_deg`` stays the raw
+cost; an uncertified path gets no shortened cost, since shortening would keep its bad edges).
+Both happen inside the worker, so they parallelise with the planning.
+
+Several rulebooks can run side by side: ``fuzzy-rrt:NAME`` (a shipped rulebook) or
+``fuzzy-rrt:DIR`` is its own planner label, with its own rows; plain ``fuzzy-rrt`` is the
+``rulebook`` argument or the shipped default. Every label is validated (and every rulebook
+loaded) before the first run.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,10 +38,8 @@ from xfuzzy_rrt.planners.api import plan_scenario
 from xfuzzy_rrt.planners.result import PlanResult, path_cost_deg
 
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "nodes", "cost_deg",
-               "wall_s", "time_first_s", "certified", "penetration_m", "rulebook",
-               "rulebook_sha256"]
-#: Our planners stop at their first solution: their time to first path is their wall time.
-_FIRST_SOLUTION_PLANNERS = ("rrt", "fuzzy-rrt")
+               "wall_s", "time_first_s", "found", "certified", "min_clearance_m",
+               "penetration_m", "rulebook", "rulebook_sha256"]
 #: Shortcutting attempts per path (the OMPL helper's default).
 SHORTCUT_ATTEMPTS = 200
 
@@ -47,13 +54,19 @@ class BenchResult:
     examples: dict[tuple[str, str], PlanResult] = field(default_factory=dict)
     scenarios: dict[str, Scenario] = field(default_factory=dict)
     settings: dict[str, Any] = field(default_factory=dict)
-    #: The loaded rulebook Fuzzy-RRT used (``None`` without fuzzy-rrt), for rule sentences.
+    #: The loaded rulebook of the first Fuzzy-RRT planner (``None`` without one), for rule
+    #: sentences; ``rulebooks`` has every Fuzzy-RRT planner label's rulebook.
     rulebook: Any = None
     #: Per planner pair, the distribution over scenarios of median-iteration ratios.
     ratios: pd.DataFrame | None = None
     #: Where the numbers came from (command, date, versions, git, machine, file hashes);
     #: filled when the result is written to or read from a bench folder (``bench.store``).
     provenance: dict[str, Any] = field(default_factory=dict)
+    #: Planner label (``fuzzy-rrt``, ``fuzzy-rrt:paper``, ...) -> the loaded rulebook it ran.
+    rulebooks: dict[str, Any] = field(default_factory=dict)
+    #: For each (scenario, planner), the returned path that came closest to an obstacle (or went
+    #: deepest into one): what a safety audit looks at, next to the median run.
+    worst_examples: dict[tuple[str, str], PlanResult] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -67,8 +80,9 @@ class _Job:
 
 
 def check_planners(planners: list[str]) -> list[str]:
-    """Validate planner names before anything runs, through the planner API (``ompl:NAME``
-    names an OMPL planner; without the extra this is one line naming it)."""
+    """Validate planner labels before anything runs, through the planner API (``ompl:NAME``
+    names an OMPL planner, ``fuzzy-rrt:NAME`` a rulebook; each error is one line naming
+    ``--planners``)."""
     from xfuzzy_rrt.planners.api import check_planner
 
     if not planners:
@@ -80,60 +94,102 @@ def check_planners(planners: list[str]) -> list[str]:
     return list(planners)
 
 
-def _certify(scenario: Scenario, path: np.ndarray) -> tuple[bool, float]:
-    from xfuzzy_rrt.geometry.path_check import certify_path
+def load_rulebooks(planners: list[str], rulebook=None) -> tuple[dict[str, Any], dict[str, str]]:
+    """Load the rulebook of every Fuzzy-RRT label: ``({label: Rulebook}, {label: directory})``.
 
-    from xfuzzy_rrt.geometry.clearance import planning_margin
+    Plain ``fuzzy-rrt`` uses ``rulebook`` (a loaded rulebook or a directory) or the shipped
+    default; ``fuzzy-rrt:NAME``/``fuzzy-rrt:DIR`` its own. Loading validates every rule, so a
+    broken rulebook fails here, before any planning.
+    """
+    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
+    from xfuzzy_rrt.planners.api import parse_planner
 
-    check = certify_path(scenario.arrays(), path, planning_margin(scenario))
-    return bool(check.certified), float(check.penetration_m)
+    books: dict[str, Any] = {}
+    dirs: dict[str, str] = {}
+    for label in planners:
+        spec = parse_planner(label, "--planners")
+        if spec.kind != "fuzzy-rrt":
+            continue
+        source = spec.rulebook_dir if spec.rulebook_dir is not None else rulebook
+        if source is None:
+            source = default_rulebook_path()
+        if hasattr(source, "arrays"):
+            books[label] = source
+            dirs[label] = None
+        else:
+            dirs[label] = str(Path(source).resolve())
+            books[label] = load_rulebook(source)
+    return books, dirs
 
 
 def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
-    from xfuzzy_rrt.geometry.clearance import planning_margin
-
     r = plan_scenario(job.scenario, planner=job.planner, rulebook=job.rulebook, seed=job.seed,
                       max_iter=job.max_iter)
     params = r.params if isinstance(r.params, dict) else {}
     time_first = params.get("time_first_s")
-    if time_first is None and r.success and (job.planner in _FIRST_SOLUTION_PLANNERS
-                                             or params.get("stopped_by") == "solution"):
+    first_solution = (job.planner == "rrt" or job.planner.startswith("fuzzy-rrt")
+                      or params.get("stopped_by") == "solution")
+    if time_first is None and r.found and first_solution:
         time_first = r.wall_s  # the run stopped at its first solution
     row: dict[str, Any] = {
         "scenario": r.scenario, "planner": job.planner, "seed": r.seed, "success": r.success,
         "iterations": r.iterations, "nodes": r.nodes,
         "cost_deg": np.nan if r.cost_deg is None else r.cost_deg, "wall_s": r.wall_s,
         "time_first_s": np.nan if time_first is None else float(time_first),
-        "certified": pd.NA, "penetration_m": np.nan,
+        "found": r.found, "certified": r.certified,
+        "min_clearance_m": np.nan if r.min_clearance_m is None else float(r.min_clearance_m),
+        "penetration_m": np.nan if r.penetration_m is None else float(r.penetration_m),
         "rulebook": r.rulebook, "rulebook_sha256": r.rulebook_sha256,
     }
-    if r.success and np.size(r.path_deg):
-        if params.get("certified") is not None and params.get("penetration_m") is not None:
-            row["certified"] = bool(params["certified"])  # the OMPL bridge already checked
-            row["penetration_m"] = float(params["penetration_m"])
-        else:
-            row["certified"], row["penetration_m"] = _certify(job.scenario, r.path_deg)
-        if job.shortcut:
+    if job.shortcut:
+        row["cost_short_deg"] = np.nan
+        if r.success:  # only a certified path: shortening keeps unchanged input edges
             from xfuzzy_rrt.planners.shortcut import shortcut_path
+
+            from xfuzzy_rrt.geometry.clearance import planning_margin
 
             short = shortcut_path(job.scenario.arrays(), r.path_deg, seed=job.seed,
                                   attempts=SHORTCUT_ATTEMPTS,
                                   margin=planning_margin(job.scenario))
             row["cost_short_deg"] = path_cost_deg(short)
-    elif job.shortcut:
-        row["cost_short_deg"] = np.nan
     return r, row
 
 
-def _warm_up(scenario: Scenario, planners: list[str], rulebook) -> None:
+def _warm_up(scenario: Scenario, planners: list[str], rulebooks: dict[str, Any]) -> None:
     """Compile/load the kernels once so that no timed run pays JIT cost.
 
     Also the first call of every planner through the API: an unusable ``ompl:NAME`` fails
     here, before any run.
     """
     for planner in planners:
-        plan_scenario(scenario, planner=planner, rulebook=rulebook if planner == "fuzzy-rrt"
-                      else None, seed=0, max_iter=5)
+        plan_scenario(scenario, planner=planner, rulebook=rulebooks.get(planner), seed=0,
+                      max_iter=5)
+
+
+def _die_with_parent(parent: int) -> None:
+    """Ask Linux to kill this worker when its parent dies (``kill -9`` included), so a killed
+    bench leaves no orphan holding its pipes; elsewhere a no-op."""
+    import ctypes
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    with contextlib.suppress(OSError, AttributeError):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+    if os.getppid() != parent:  # the parent died before the request took effect
+        os._exit(1)
+
+
+def _worker_init(parent: int, scenario: Scenario, planners: list[str],
+                 rulebooks: dict[str, Any]) -> None:
+    """Worker start-up: die with the parent, leave Ctrl-C to it (it cancels the pool and
+    reports once; a worker's KeyboardInterrupt traceback is noise), then warm up."""
+    _die_with_parent(parent)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    with contextlib.suppress(AttributeError, ValueError):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    _warm_up(scenario, planners, rulebooks)
 
 
 def _median_run_seed(group: pd.DataFrame) -> int | None:
@@ -142,6 +198,15 @@ def _median_run_seed(group: pd.DataFrame) -> int | None:
         return None
     target = ok["iterations"].median()
     return int(ok["seed"].iloc[int(np.argmin(np.abs(ok["iterations"].to_numpy() - target)))])
+
+
+def _worst_run_seed(group: pd.DataFrame) -> int | None:
+    """Seed of the found run with the smallest minimum clearance (the first on ties)."""
+    found = group[group["found"].astype(bool)]
+    if found.empty:
+        return None
+    clearance = pd.to_numeric(found["min_clearance_m"], errors="coerce").fillna(np.inf)
+    return int(found["seed"].iloc[int(np.argmin(clearance.to_numpy()))])
 
 
 def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50, seed: int = 0,
@@ -162,20 +227,10 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
     if len(set(names)) != len(names):
         dup = sorted({n for n in names if names.count(n) > 1})[0]
         raise InputError("scenarios", f"two scenario files share the name {dup!r}")
-    rulebook_dir = None
-    if "fuzzy-rrt" in planners:
-        from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
-
-        if rulebook is None:
-            rulebook = default_rulebook_path()
-        if not hasattr(rulebook, "arrays"):
-            rulebook_dir = str(Path(rulebook).resolve())
-            rulebook = load_rulebook(rulebook)
-    else:
-        rulebook = None
-    jobs = [_Job(s, p, rulebook if p == "fuzzy-rrt" else None, seed + k, max_iter, shortcut)
+    rulebooks, rulebook_dirs = load_rulebooks(planners, rulebook)
+    jobs = [_Job(s, p, rulebooks.get(p), seed + k, max_iter, shortcut)
             for s in scenarios for p in planners for k in range(runs)]
-    _warm_up(scenarios[0], planners, rulebook)
+    _warm_up(scenarios[0], planners, rulebooks)
     outputs: list[tuple[PlanResult, dict[str, Any]]] = []
     if workers == 1:
         for j in jobs:
@@ -183,38 +238,79 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
             if progress is not None:
                 progress(len(outputs), len(jobs))
     else:
-        with ProcessPoolExecutor(max_workers=min(workers, os.cpu_count() or 1),
-                                 initializer=_warm_up,
-                                 initargs=(scenarios[0], planners, rulebook)) as pool:
-            chunk = max(1, min(16, len(jobs) // (8 * workers)))
-            for out in pool.map(_one_run, jobs, chunksize=chunk):
-                outputs.append(out)
-                if progress is not None:
-                    progress(len(outputs), len(jobs))
+        outputs = _run_pool(jobs, workers, (os.getpid(), scenarios[0], planners, rulebooks),
+                            progress)
     columns = RUN_COLUMNS + (["cost_short_deg"] if shortcut else [])
     runs_df = pd.DataFrame([row for _, row in outputs], columns=columns)
-    runs_df["certified"] = runs_df["certified"].astype("boolean")
+    for col in ("success", "found", "certified"):
+        runs_df[col] = runs_df[col].astype(bool)
     summary = summarise(runs_df)
     by_name = {s.name: s for s in scenarios}
-    by_run = {(r.scenario, r.planner, r.seed): r for r, _ in outputs}
+    by_run = {(r.scenario, row["planner"], r.seed): r for r, row in outputs}
     examples = {}
     for (scen, planner), group in runs_df.groupby(["scenario", "planner"], sort=False):
         seed_ = _median_run_seed(group)
         if seed_ is None:
             continue
         example = by_run[(scen, planner, seed_)]
-        if planner == "fuzzy-rrt":
+        if planner in rulebooks:
             # Re-run the example with tracing (deterministic: the same run, plus its trace)
             # so the report can show what the fuzzy systems decided.
-            example = plan_scenario(by_name[scen], planner=planner, rulebook=rulebook,
+            example = plan_scenario(by_name[scen], planner=planner, rulebook=rulebooks[planner],
                                     seed=seed_, max_iter=max_iter, trace=True)
         examples[(scen, planner)] = example
+    worst = {}
+    for (scen, planner), group in runs_df.groupby(["scenario", "planner"], sort=False):
+        seed_ = _worst_run_seed(group)
+        if seed_ is not None:
+            same = examples.get((scen, planner))
+            worst[(scen, planner)] = (same if same is not None and same.seed == seed_
+                                      else by_run[(scen, planner, seed_)])
+    first = next(iter(rulebooks), None)
+    main_label = "fuzzy-rrt" if "fuzzy-rrt" in rulebooks else first
+    main_rb = rulebooks.get(main_label) if main_label else None
     settings = {"runs": runs, "seed": seed, "max_iter": max_iter, "planners": list(planners),
                 "shortcut": bool(shortcut), "workers": int(workers),
-                "rulebook": getattr(rulebook, "name", None), "rulebook_dir": rulebook_dir,
-                "rulebook_sha256": getattr(rulebook, "sha256", None)}
+                "rulebook": getattr(main_rb, "name", None),
+                "rulebook_dir": rulebook_dirs.get(main_label) if main_label else None,
+                "rulebook_sha256": getattr(main_rb, "sha256", None),
+                "rulebooks": [{"planner": label, "name": rb.name, "dir": rulebook_dirs[label],
+                               "sha256": rb.sha256} for label, rb in rulebooks.items()]}
     return BenchResult(runs=runs_df, summary=summary, examples=examples, scenarios=by_name,
-                       settings=settings, rulebook=rulebook, ratios=ratio_table(summary))
+                       settings=settings, rulebook=main_rb, ratios=ratio_table(summary),
+                       rulebooks=dict(rulebooks), worst_examples=worst)
+
+
+def _run_pool(jobs: list[_Job], workers: int, init_args: tuple, progress: Progress | None):
+    """Run ``jobs`` on worker processes, results in job order.
+
+    Ctrl-C: workers ignore SIGINT (:func:`_worker_init`; SIGINT is also blocked while they are
+    forked, so none can catch it before it runs), the parent cancels what has not started and
+    re-raises, so the user sees one line from the CLI and no worker traceback.
+    """
+    outputs = []
+    blocked = False
+    with contextlib.suppress(AttributeError, ValueError):
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        blocked = True
+    pool = ProcessPoolExecutor(max_workers=min(workers, os.cpu_count() or 1),
+                               initializer=_worker_init, initargs=init_args)
+    try:
+        try:
+            chunk = max(1, min(16, len(jobs) // (8 * workers)))
+            results = pool.map(_one_run, jobs, chunksize=chunk)  # forks the workers now
+        finally:
+            if blocked:
+                signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+        for out in results:
+            outputs.append(out)
+            if progress is not None:
+                progress(len(outputs), len(jobs))
+    except BaseException:
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+    return outputs
 
 
 def scenario_files(paths: list[Path]) -> list[Path]:

@@ -7,16 +7,25 @@ runs DataFrame -- freshly computed or read back from disk -- and nothing else.
 
 Conventions (the paper's, kept for every planner):
 
+- ``success`` means a *certified* path: found and passing the certified check. ``success_rate``
+  counts those only; ``found_rate`` beside it counts every returned path, and
+  ``certified_fraction`` is the share of returned paths that are certified (always 1 for our
+  planners; OMPL checks motions by sampling, so its paths may graze obstacles, by up to
+  ``penetration_max_m``); ``min_clearance_min_m`` is the smallest exact clearance of any
+  returned path (negative: a penetration depth);
 - iteration statistics cover *all* runs; a failed run counts as ``max_iter`` iterations (the
-  planner reports that), it is never dropped;
-- cost statistics cover successful runs only (a failed run has no path);
-- ``certified_fraction`` is over successful runs: the share whose returned path passes this
-  project's certified edge check (always 1 for our planners; OMPL checks motions by sampling,
-  so its paths may graze obstacles);
-- a planner pair's *ratio* on one scenario is ``baseline median iterations / planner median
-  iterations`` (above 1: the planner needed fewer iterations than the baseline), and the ratio
-  table gives its distribution over scenarios -- this is how "2x faster" is judged across many
-  problems instead of one.
+  planner reports that), it is never dropped; likewise ``time_first_median_s`` is over all runs,
+  a run without a certified path counting with the time it spent (its ``wall_s``);
+- cost statistics cover successful runs only (a failed run has no path), and so does the
+  shortened cost (a path that is not certified is not shortened);
+- a planner's per-scenario *ratio* to the baseline (RRT) is ``baseline median / planner
+  median`` (above 1: the planner needed less than the baseline). Our planners (``rrt``,
+  ``fuzzy-rrt``, ``fuzzy-rrt:RULEBOOK``) are compared on iterations, which count the same loop;
+  OMPL's planners count iterations their own way, so they are compared on time to first path
+  only (``time_ratio_vs_rrt``; their ``iter_ratio_vs_rrt`` is left empty). The ratio table
+  gives the distribution over scenarios (median, worst, best, geometric mean) with the metric
+  named in its ``metric`` column -- this is how "2x faster" is judged across many problems
+  instead of one.
 """
 
 from __future__ import annotations
@@ -25,14 +34,23 @@ import numpy as np
 import pandas as pd
 
 BASELINE = "rrt"
+ITERATIONS = "iterations"
+TIME_FIRST = "time_first_s"
 
-SUMMARY_COLUMNS = ["scenario", "planner", "runs", "success_rate", "iterations_min",
+SUMMARY_COLUMNS = ["scenario", "planner", "runs", "success_rate", "found_rate", "iterations_min",
                    "iterations_median", "iterations_max", "cost_min", "cost_median", "cost_max",
                    "wall_median_s", "time_first_median_s", "certified_fraction",
-                   "penetration_max_m", "iter_ratio_vs_rrt"]
+                   "penetration_max_m", "min_clearance_min_m", "iter_ratio_vs_rrt",
+                   "time_ratio_vs_rrt"]
 SHORTCUT_COLUMNS = ["cost_short_median"]
-RATIO_COLUMNS = ["baseline", "planner", "scenarios", "ratio_median", "ratio_worst",
+RATIO_COLUMNS = ["baseline", "planner", "metric", "scenarios", "ratio_median", "ratio_worst",
                  "ratio_best", "ratio_geomean"]
+
+
+def ratio_metric(planner: str) -> str:
+    """What a planner is compared to RRT on: iterations for ours, time to first path for OMPL's
+    (whose iteration counts are not our loop's)."""
+    return TIME_FIRST if str(planner).startswith("ompl:") else ITERATIONS
 
 
 def _bool(series: pd.Series) -> pd.Series:
@@ -48,17 +66,30 @@ def _median(values: pd.Series) -> float:
     return float(values.median()) if len(values) else float("nan")
 
 
+def _time_spent(g: pd.DataFrame, success: pd.Series) -> pd.Series:
+    """Time to first certified path per run; a run without one counts with its wall time."""
+    first = pd.to_numeric(g["time_first_s"], errors="coerce") if "time_first_s" in g else \
+        pd.Series(np.nan, index=g.index)
+    wall = pd.to_numeric(g["wall_s"], errors="coerce")
+    return first.where(success & first.notna(), wall)
+
+
 def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     """One row per (scenario, planner), in order of first appearance in ``runs``."""
     rows = []
-    success = _bool(runs["success"]).astype(bool)
+    success = _bool(runs["success"]).fillna(False).astype(bool)
+    found = (_bool(runs["found"]).fillna(False).astype(bool) if "found" in runs.columns
+             else success)
     shortcut = "cost_short_deg" in runs.columns
     for (scen, planner), g in runs.groupby(["scenario", "planner"], sort=False):
         ok_mask = success.loc[g.index]
+        found_mask = found.loc[g.index]
         ok = g[ok_mask]
+        got = g[found_mask]
         row = {
             "scenario": scen, "planner": planner, "runs": len(g),
             "success_rate": float(ok_mask.mean()),
+            "found_rate": float(found_mask.mean()),
             "iterations_min": int(g["iterations"].min()),
             "iterations_median": float(g["iterations"].median()),
             "iterations_max": int(g["iterations"].max()),
@@ -66,45 +97,63 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
             "cost_median": float(ok["cost_deg"].median()) if len(ok) else np.nan,
             "cost_max": float(ok["cost_deg"].max()) if len(ok) else np.nan,
             "wall_median_s": float(g["wall_s"].median()),
-            "time_first_median_s": (_median(ok["time_first_s"])
-                                    if "time_first_s" in g.columns else np.nan),
+            "time_first_median_s": float(_time_spent(g, ok_mask).median()),
             "certified_fraction": np.nan,
             "penetration_max_m": np.nan,
+            "min_clearance_min_m": np.nan,
         }
-        if "certified" in g.columns and len(ok):
-            cert = _bool(ok["certified"])
-            row["certified_fraction"] = float(cert.astype(bool).mean())
-        if "penetration_m" in g.columns and len(ok):
-            pen = pd.to_numeric(ok["penetration_m"], errors="coerce").dropna()
+        if "certified" in g.columns and len(got):
+            row["certified_fraction"] = float(_bool(got["certified"]).fillna(False)
+                                              .astype(bool).mean())
+        if "penetration_m" in g.columns and len(got):
+            pen = pd.to_numeric(got["penetration_m"], errors="coerce").dropna()
             row["penetration_max_m"] = float(pen.max()) if len(pen) else np.nan
+        if "min_clearance_m" in g.columns and len(got):
+            row["min_clearance_min_m"] = _min(got["min_clearance_m"])
         if shortcut:
             row["cost_short_median"] = _median(ok["cost_short_deg"])
         rows.append(row)
     columns = SUMMARY_COLUMNS + (SHORTCUT_COLUMNS if shortcut else [])
     frame = pd.DataFrame(rows, columns=columns)
-    frame["iter_ratio_vs_rrt"] = scenario_ratios(frame)
+    frame["iter_ratio_vs_rrt"] = scenario_ratios(frame, metric=ITERATIONS).where(
+        frame["planner"].map(ratio_metric) == ITERATIONS)
+    frame["time_ratio_vs_rrt"] = scenario_ratios(frame, metric=TIME_FIRST)
     return frame
 
 
-def scenario_ratios(summary: pd.DataFrame, baseline: str = BASELINE) -> pd.Series:
-    """Per summary row: baseline median iterations / this planner's (NaN without a baseline)."""
-    base = summary[summary["planner"] == baseline].set_index("scenario")["iterations_median"]
+def _min(values: pd.Series) -> float:
+    values = pd.to_numeric(values, errors="coerce").dropna()
+    return float(values.min()) if len(values) else float("nan")
+
+
+_STAT = {ITERATIONS: "iterations_median", TIME_FIRST: "time_first_median_s"}
+
+
+def scenario_ratios(summary: pd.DataFrame, baseline: str = BASELINE,
+                    metric: str = ITERATIONS) -> pd.Series:
+    """Per summary row: baseline median / this planner's, of ``metric`` (NaN without a
+    baseline)."""
+    col = _STAT[metric]
+    base = summary[summary["planner"] == baseline].set_index("scenario")[col]
     ref = summary["scenario"].map(base).astype(float)
-    mine = summary["iterations_median"].astype(float)
+    mine = summary[col].astype(float)
     return pd.Series(np.where(mine > 0, ref / mine.where(mine > 0, np.nan), np.nan),
                      index=summary.index, dtype=float)
 
 
 def ratio_table(summary: pd.DataFrame, baseline: str = BASELINE) -> pd.DataFrame:
     """Per planner other than ``baseline``: the distribution over scenarios of its per-scenario
-    median-iteration ratio (``worst`` = smallest ratio, ``best`` = largest)."""
-    ratios = summary.assign(_r=scenario_ratios(summary, baseline))
+    ratio on its metric (:func:`ratio_metric`; ``worst`` = smallest ratio, ``best`` = largest,
+    ``geomean`` = geometric mean)."""
     rows = []
-    for planner, g in ratios[ratios["planner"] != baseline].groupby("planner", sort=False):
-        r = g["_r"].dropna().to_numpy(dtype=float)
+    others = summary[summary["planner"] != baseline]
+    for planner, g in others.groupby("planner", sort=False):
+        metric = ratio_metric(planner)
+        r = scenario_ratios(summary, baseline, metric).loc[g.index].dropna().to_numpy(dtype=float)
         if r.size == 0:
             continue
-        rows.append({"baseline": baseline, "planner": planner, "scenarios": int(r.size),
+        rows.append({"baseline": baseline, "planner": planner, "metric": metric,
+                     "scenarios": int(r.size),
                      "ratio_median": float(np.median(r)), "ratio_worst": float(r.min()),
                      "ratio_best": float(r.max()),
                      "ratio_geomean": float(np.exp(np.mean(np.log(r)))) if np.all(r > 0)

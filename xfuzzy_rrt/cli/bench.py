@@ -38,47 +38,69 @@ class ProgressBar:
 
 
 def write_outputs(result, out: Path, command: str):
-    """Write the tables, bench.json, the example runs and report.html into ``out``."""
+    """Write the tables, bench.json, the example runs and report.html into ``out`` (the staged
+    folder; :func:`xfuzzy_rrt.bench.store.staged_folder` swaps it in)."""
     from xfuzzy_rrt.atomic import atomic_path
     from xfuzzy_rrt.bench.provenance import collect
     from xfuzzy_rrt.bench.store import write_bench_dir
+    from xfuzzy_rrt.cli.common import test_signal
     from xfuzzy_rrt.report.bench_report import write_bench_report
 
     result = write_bench_dir(result, out, collect(command))
+    test_signal("tables")
     with atomic_path(out / "report.html") as tmp:
         write_bench_report(result, tmp, command=command)
+    test_signal("report")
     return result
 
 
 def _render_summary(summary) -> str:
-    cols = ["scenario", "planner", "success_rate", "iterations_min", "iterations_median",
-            "iterations_max", "cost_median", "wall_median_s", "certified_fraction"]
+    cols = ["scenario", "planner", "success_rate", "found_rate", "iterations_min",
+            "iterations_median", "iterations_max", "cost_median", "wall_median_s",
+            "certified_fraction", "min_clearance_min_m"]
     if "cost_short_median" in summary.columns:
-        cols.insert(7, "cost_short_median")
+        cols.insert(8, "cost_short_median")
     view = summary[[c for c in cols if c in summary.columns]].copy()
     view["wall_median_ms"] = view.pop("wall_median_s") * 1e3
+    if "min_clearance_min_m" in view:
+        view["min_clearance_mm"] = view.pop("min_clearance_min_m") * 1e3
     return view.to_string(index=False, float_format=lambda x: f"{x:.3f}")
 
 
 def _run(scenarios: List[Path], planners: str, runs: int, seed: int, rulebook: Optional[Path],
          max_iter: int, out: Path, workers: int, shortcut: bool = False,
-         clearance: float | None = None) -> int:
+         keep: tuple[str, ...] = (), clearance: float | None = None) -> int:
+    """Plan and write one bench folder, replaced as a set (``keep``: entries of an existing
+    folder to carry over, e.g. the demo's scenarios). Ctrl-C: one line, the previous folder
+    (or none) stays, exit 130."""
     from xfuzzy_rrt.bench.runner import check_planners, run_benchmark, scenario_files
-    from xfuzzy_rrt.cli.common import load_scenario_warn
+    from xfuzzy_rrt.bench.store import check_out_dir, staged_folder
+    from xfuzzy_rrt.cli.common import load_scenario_warn, test_signal
 
-    from xfuzzy_rrt.errors import InputError
-
-    if out.exists() and not out.is_dir():  # fail before planning, not after
-        raise InputError(str(out), "exists and is not a directory (--out names a folder)")
     names = check_planners([p.strip() for p in planners.split(",") if p.strip()])
+    files = scenario_files(scenarios)
+    check_out_dir(out, files, keep)  # fail before planning, not after
     from xfuzzy_rrt.geometry.clearance import with_clearance
 
-    loaded = [with_clearance(load_scenario_warn(p), clearance) for p in scenario_files(scenarios)]
-    result = run_benchmark(loaded, names, runs=runs, seed=seed, rulebook=rulebook,
-                           max_iter=max_iter, workers=workers, shortcut=shortcut,
-                           progress=ProgressBar())
+    loaded = [with_clearance(load_scenario_warn(p), clearance) for p in files]
+    bar = ProgressBar()
+
+    def progress(done: int, total: int) -> None:
+        bar(done, total)
+        test_signal(f"runs:{done}")
+
     command = "xfuzzy-rrt " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-    write_outputs(result, out, command)
+    try:
+        with staged_folder(out, keep) as stage:
+            result = run_benchmark(loaded, names, runs=runs, seed=seed, rulebook=rulebook,
+                                   max_iter=max_iter, workers=workers, shortcut=shortcut,
+                                   progress=progress)
+            write_outputs(result, stage, command)
+    except KeyboardInterrupt:
+        state = "the previous folder is unchanged" if out.exists() else "nothing was written"
+        sys.stderr.write(f"\ninterrupted: {out}: {state}\n")
+        sys.stderr.flush()
+        raise
     typer.echo(_render_summary(result.summary))
     if result.ratios is not None and len(result.ratios):
         typer.echo(result.ratios.to_string(index=False, float_format=lambda x: f"{x:.3f}"))
@@ -93,11 +115,15 @@ def _default_out(prefix: str) -> Path:
 
 def bench(
     scenarios: List[Path] = typer.Argument(..., help="Scenario TOML files or directories of them."),
-    planners: str = typer.Option("rrt,fuzzy-rrt", "--planners",
-                                 help="Comma list: rrt, fuzzy-rrt, ompl:NAME (e.g. ompl:RRTConnect)."),
+    planners: str = typer.Option(
+        "rrt,fuzzy-rrt", "--planners",
+        help="Comma list: rrt, fuzzy-rrt (the --rulebook or default rulebook), "
+             "fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR (a rulebook directory; "
+             "several side by side), ompl:NAME (e.g. ompl:RRTConnect)."),
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),
     seed: int = typer.Option(0, "--seed", help="First seed; run k uses seed + k."),
-    rulebook: Optional[Path] = typer.Option(None, "--rulebook", help="Rulebook directory."),
+    rulebook: Optional[Path] = typer.Option(None, "--rulebook",
+                                            help="Rulebook directory of plain fuzzy-rrt."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Output folder (default reports/bench-<time>)."),
     workers: int = typer.Option(1, "--workers", min=1, help="Worker processes."),
@@ -109,38 +135,43 @@ def bench(
 ) -> int:
     """Benchmark planners: runs.csv, summary.csv, ratios.csv and report.html in the output folder."""
     return _run(scenarios, planners, runs, seed, rulebook, max_iter, out or _default_out("bench"),
-                workers, shortcut, clearance)
+                workers, shortcut, clearance=clearance)
 
 
 def demo(
     out: Path = typer.Option(Path("reports/demo"), "--out", help="Output folder."),
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),
     workers: int = typer.Option(2, "--workers", min=1, help="Worker processes."),
+    problems: int = typer.Option(24, "--problems", min=1, max=1000,
+                                 help="Generated problems to benchmark (generator seed 2000)."),
 ) -> int:
     """Benchmark RRT vs the trained Fuzzy-RRT and write the reports.
 
-    The default rulebook (``general``, trained on generated problems only) on 24 fresh
-    problems of the ``sample-*`` family that no training run saw (generator seed 2000; the
-    files are written to OUT/scenarios), into OUT; and, when the shared reference problem sits
-    beside the project, the ``paper`` rulebook (the paper's setting) on it, into
-    OUT/paper-reference.
+    Two benchmarks, everything shipped in the package: (1) RRT vs Fuzzy-RRT with the default
+    rulebook (``goal-frame``, trained on generated problems only) on the shipped demo scenarios
+    and PROBLEMS fresh problems of the ``sample-*`` family that no training run saw (generator
+    seed 2000; the files are written to OUT/scenarios), into OUT; (2) on the paper's reference
+    problem, RRT, the default rulebook and the ``paper`` rulebook (the paper's setting) side by
+    side, into OUT/paper-reference.
     """
     from xfuzzy_rrt.atomic import write_text_atomic
-    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+    from xfuzzy_rrt.bench.runner import shipped_scenarios
+    from xfuzzy_rrt.resources import paper_reference_scenario
     from xfuzzy_rrt.scenarios.generate import generate_one
 
-    files = []
-    for k in range(24):
+    files = list(shipped_scenarios())
+    for k in range(problems):
         problem = generate_one(2000, k)
         path = out / "scenarios" / f"{problem.scenario.name}.toml"
         write_text_atomic(path, problem.text)
         files.append(path)
-    code = _run(files, "rrt,fuzzy-rrt", runs, 0, None, 10_000, out, workers)
-    reference = rulebooks_dir().parent.parent / "shared" / "scenarios" / "paper-reference.toml"
-    paper = rulebooks_dir() / "paper"
-    if reference.is_file() and paper.is_dir():
-        code = max(code, _run([reference], "rrt,fuzzy-rrt", runs, 0, paper, 10_000,
-                              out / "paper-reference", workers))
+    code = _run(files, "rrt,fuzzy-rrt", runs, 0, None, 10_000, out, workers,
+                keep=("scenarios", "paper-reference"))
+    for stale in sorted((out / "scenarios").glob("*.toml")):
+        if stale not in files:  # from an earlier demo with more --problems
+            stale.unlink()
+    code = max(code, _run([paper_reference_scenario()], "rrt,fuzzy-rrt,fuzzy-rrt:paper", runs, 0,
+                          None, 10_000, out / "paper-reference", workers))
     return code
 
 

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import json
+import os
+import signal
 import sys
+import tempfile
 from pathlib import Path
 from typing import Any
 
 from xfuzzy_rrt.atomic import write_text_atomic
+from xfuzzy_rrt.errors import InputError
 
 
 def warn(message: str) -> None:
@@ -15,13 +19,10 @@ def warn(message: str) -> None:
 
 
 def load_scenario_warn(path: Path):
-    """Load a scenario; warn (stderr) about keys the format does not know (likely typos)."""
+    """Load a scenario (an unknown key is an error there, not a warning: see xfuzzy_rrt.strict)."""
     from xfuzzy_rrt.geometry.scenario import load_scenario
 
-    scenario = load_scenario(path)
-    for key in scenario.unknown_keys:
-        warn(f"{path}: {key}: unknown key ignored")
-    return scenario
+    return load_scenario(path)
 
 
 def format_json(obj: dict[str, Any]) -> str:
@@ -37,3 +38,53 @@ def emit_json(obj: dict[str, Any], out: Path | None) -> None:
         sys.stdout.write(text)
     else:
         write_text_atomic(out, text)
+
+
+def check_output_file(path: Path | None, option: str) -> None:
+    """Fail before any work when ``path`` (an output file) cannot be written.
+
+    Creates and removes a probe file in the nearest existing folder (permission bits say
+    nothing to root, and a read-only mount only shows on writing), so the error names the
+    user's path and comes before planning, not after.
+    """
+    if path is None:
+        return
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(str(path), f"is a directory ({option} names a file)")
+    anchor = Path(os.path.abspath(path.parent))
+    while not anchor.exists() and anchor != anchor.parent:
+        anchor = anchor.parent
+    if not anchor.is_dir():
+        raise InputError(str(path), f"cannot create it: {anchor} is not a directory")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".probe", dir=anchor)
+    except OSError as exc:
+        raise InputError(str(path), f"cannot write here: {exc.strerror or exc}") from None
+    os.close(fd)
+    os.unlink(probe)
+
+
+#: Test hook: ``SIG@POINT`` (``INT@runs:3``, ``KILL@report``, ...) signals this process at a
+#: named point of a command, so interruption tests hit a known moment instead of racing a
+#: poll. Unset in normal use; see :func:`test_signal`.
+TEST_SIGNAL_ENV = "XFUZZY_RRT_TEST_SIGNAL"
+
+
+def test_signal(point: str) -> None:
+    """If ``$XFUZZY_RRT_TEST_SIGNAL`` is ``SIG@point``, send SIG (``INT`` or ``KILL``) now.
+
+    ``INT`` goes to the whole process group when this process leads one (as a terminal's
+    Ctrl-C reaches the workers too), else to this process only.
+    """
+    spec = os.environ.get(TEST_SIGNAL_ENV)
+    if not spec or spec.partition("@")[2] != point:
+        return
+    name = spec.partition("@")[0]
+    if name == "KILL":
+        os.kill(os.getpid(), signal.SIGKILL)
+    elif name == "INT":
+        if os.getpgrp() == os.getpid():
+            os.killpg(os.getpgrp(), signal.SIGINT)
+        else:
+            os.kill(os.getpid(), signal.SIGINT)

@@ -55,10 +55,31 @@ def _print_error(line: str) -> None:
     sys.stderr.flush()
 
 
+#: Commands that run compiled planners (``rules`` subcommands that plan are listed as pairs).
+_PLANNING = {"plan", "bench", "demo", "explain", "train", ("rules", "coverage"),
+             ("rules", "diff"), ("rules", "simplify"), ("scenarios", "generate")}
+
+
+def _announce_first_compile(args: list[str]) -> None:
+    """One stderr line when numba starts compiling (the first run after an install takes tens
+    of seconds: say why rather than look hung). Nothing when the kernels come from its cache."""
+    words = [a for a in args if not a.startswith("-")][:2]
+    if not words or "--help" in args or not (words[0] in _PLANNING or tuple(words) in _PLANNING):
+        return
+    from xfuzzy_rrt.compile_notice import notify_first_compile
+
+    def say() -> None:
+        sys.stderr.write("compiling planners, first run only…\n")
+        sys.stderr.flush()
+
+    notify_first_compile(say)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; return (and, as a script, exit with) the process exit code."""
     args = sys.argv[1:] if argv is None else list(argv)
     command = typer.main.get_command(app)
+    _announce_first_compile(args)
     try:
         rv = command.main(args=args, prog_name="xfuzzy-rrt", standalone_mode=False)
     except RulebookError as exc:

@@ -18,7 +18,8 @@ def plan(
     scenario: Path = typer.Argument(..., help="Scenario TOML file."),
     planner: str = typer.Option(
         PlannerName.fuzzy_rrt.value, "--planner",
-        help="Planner: rrt, fuzzy-rrt, or ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
+        help="Planner: rrt, fuzzy-rrt, fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, or "
+             "ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
     rulebook: Optional[Path] = typer.Option(
         None, "--rulebook", help="Rulebook directory (fuzzy-rrt; default: the shipped default)."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
@@ -31,21 +32,31 @@ def plan(
     clearance: Optional[float] = typer.Option(
         None, "--clearance", help="Certified clearance in metres every link keeps from every obstacle (default: the scenario's [safety] clearance_m, else 0)."),
 ) -> int:
-    """Plan a path from the scenario's start to its goal. Exit 1 when no path is found."""
-    from xfuzzy_rrt.cli.common import emit_json, load_scenario_warn
-    from xfuzzy_rrt.planners.api import check_planner, plan_scenario, write_trace_checked
+    """Plan a path from the scenario's start to its goal.
 
-    check_planner(planner, "--planner")
+    Exit 1 when no path is found within --max-iter, or when the path found is not certified
+    collision-free (one line on stderr says where it penetrates and how deep).
+    """
+    from xfuzzy_rrt.cli.common import check_output_file, emit_json, load_scenario_warn
+    from xfuzzy_rrt.planners.api import parse_planner, plan_scenario, write_trace_checked
+
+    spec = parse_planner(planner, "--planner")
     if trace is not None:
         write_trace_checked(trace)  # reject a bad suffix before any work is done
+    check_output_file(out, "--out")
+    check_output_file(trace, "--trace")
     s = load_scenario_warn(scenario)
-    if planner == PlannerName.fuzzy_rrt.value:
+    rulebook_dir = None
+    rulebook_obj = None
+    if spec.kind == "fuzzy-rrt":
+        from xfuzzy_rrt.errors import InputError
         from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
 
-        rulebook = rulebook if rulebook is not None else default_rulebook_path()
-        rulebook_obj = load_rulebook(rulebook)
-    else:
-        rulebook_obj = None
+        if spec.rulebook_dir is not None and rulebook is not None:
+            raise InputError("--rulebook", f"conflicts with --planner {planner} (which names "
+                             "its own rulebook); give only one")
+        rulebook_dir = spec.rulebook_dir or rulebook or default_rulebook_path()
+        rulebook_obj = load_rulebook(rulebook_dir)
     result = plan_scenario(
         s, planner=planner, rulebook=rulebook_obj, seed=seed, max_iter=max_iter,
         step_deg=step_deg, goal_bias=goal_bias, trace=trace is not None, clearance_m=clearance,
@@ -57,8 +68,13 @@ def plan(
     data = result.to_json_dict()
     # Where the inputs came from, so that 'xfuzzy-rrt explain RESULT.json' can replay the run.
     data["scenario_file"] = str(scenario.resolve())
-    data["rulebook_dir"] = str(rulebook.resolve()) if rulebook_obj is not None else None
+    data["rulebook_dir"] = str(Path(rulebook_dir).resolve()) if rulebook_obj is not None else None
     emit_json(data, out)
+    if result.found and not result.certified:
+        import sys
+
+        sys.stderr.write(f"not certified: {scenario}: {result.planner} seed {seed}: "
+                         f"{result.violation}\n")
     return 0 if result.success else 1
 
 

@@ -56,7 +56,8 @@ def lint(rulebook: Path = typer.Argument(..., help="Rulebook directory.")) -> in
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 
     rb = load_rulebook(rulebook)
-    _out(f"ok: {rulebook}: rulebook {rb.name!r} ({rb.bounds_mode} bounds), sha256 {rb.sha256}")
+    kind = f"{rb.bounds_mode} bounds" if rb.bounds_mode else f"{rb.semantics.name} semantics"
+    _out(f"ok: {rulebook}: rulebook {rb.name!r} ({kind}), sha256 {rb.sha256}")
     return 0
 
 
@@ -108,7 +109,8 @@ def show(
         _out("\n".join(lines))
         return 0
 
-    lines = [f"rulebook {rb.name!r}  ({rulebook})", f"  bounds mode: {rb.bounds_mode}",
+    lines = [f"rulebook {rb.name!r}  ({rulebook})", f"  semantics: {rb.semantics.summary}",
+             f"  bounds mode: {rb.bounds_mode or '(none: not the paper semantics)'}",
              f"  sha256: {rb.sha256}"]
     if rb.description:
         lines.append(f"  description: {rb.description}")
@@ -401,6 +403,7 @@ def simplify_cmd(
     strict: bool = typer.Option(False, "--strict", help="Require loss + 1.645 standard errors "
                                 "(paired over seeds) to be within the budget, not just the mean."),
     workers: int = typer.Option(1, "--workers", min=1, help="Worker processes for the budget runs."),
+    holdout_seeds: Optional[int] = typer.Option(None, "--holdout-seeds", min=1, help="Fresh seeds per scenario (never searched on) to re-measure a lossy result's loss (default: --seeds)."),
 ) -> int:
     """Fewest 'any' rules with the same constants; lossy steps only within a stated budget."""
     from xfuzzy_rrt.analysis.simplify import simplify as run_simplify
@@ -414,7 +417,8 @@ def simplify_cmd(
     scenarios = [load_scenario_warn(p) for p in (scenario or [])]
     res = run_simplify(rb, name=name, command=_command_line(), budget=budget, scenarios=scenarios,
                        seeds=seeds, seed=seed, max_iter=max_iter, levels=levels,
-                       tolerance=tolerance, absorb=absorb, strict=strict, workers=workers)
+                       tolerance=tolerance, absorb=absorb, strict=strict, workers=workers,
+                       holdout_seeds=holdout_seeds)
     save_rulebook(res.rulebook, out, compact=True)
     lines = [f"source {rulebook}: {rb.name!r}, sha256 {rb.sha256[:12]}..."]
     rel = res.budget is not None and res.budget.relative
@@ -443,8 +447,17 @@ def simplify_cmd(
     lines.append("rule count: proven minimal for every FIS (exact 0/1 programme)" if not not_proven
                  else f"rule count: not proven minimal for {', '.join(not_proven)} (solver time limit)")
     if res.budget is not None:
-        lines.append(f"measured: mean iterations {res.base_mean:.2f} -> {res.new_mean:.2f} "
-                     f"(loss {loss_text(res.loss)}, budget {res.budget})")
+        lines.append(f"measured on the searched seeds: mean iterations {res.base_mean:.2f} -> "
+                     f"{res.new_mean:.2f} (loss {loss_text(res.loss)}, budget {res.budget})")
+    if res.holdout_loss is not None:
+        first, last = res.holdout_seeds
+        verdict = "within budget" if res.holdout_within_budget else "OVER BUDGET"
+        lines.append(f"held out (fresh seeds {first}..{last}, not searched on): mean iterations "
+                     f"{res.holdout_base_mean:.2f} -> {res.holdout_new_mean:.2f} "
+                     f"(loss {loss_text(res.holdout_loss)}; {verdict})")
+        if not res.holdout_within_budget:
+            lines.append("warning: the loss on fresh seeds exceeds the budget; the in-sample "
+                         "figure was luck of the searched seeds (try more --seeds or --strict)")
     if res.absorbed_cells:
         lines.append(f"warning: {res.absorbed_cells} cells that never fired (or were weak) on the "
                      "budget runs changed value; behaviour elsewhere may differ")

@@ -82,14 +82,25 @@ def train(
     block_rate: float = typer.Option(0.5, "--block-rate", help="Per-child probability of a term-block mutation."),
     block_sigma: float = typer.Option(0.05, "--block-sigma", help="Scale of term-block mutations (genes are in [0, 1])."),
     init: str = typer.Option("seeded", "--init", help="First generation: seeded (known rulebooks + perturbations) or random."),
+    seed_rulebook: Optional[List[Path]] = typer.Option(None, "--seed-rulebook", help="Rulebook directory the seeded first generation starts from (repeatable; default: the shipped expert when its bounds mode matches --bounds). Its SHA-256 is recorded."),
     validation_runs: int = typer.Option(50, "--validation-runs", help="Runs per scenario to choose the final rulebook."),
     name: Optional[str] = typer.Option(None, "--name", help="Rulebook name (default: the --out folder's name)."),
     clearance: Optional[float] = typer.Option(None, "--clearance", help="Certified clearance in metres the planner must keep while training (default: each scenario's, else 0)."),
 ) -> int:
     """Train the six fuzzy systems with the paper's genetic algorithm; write a rulebook."""
-    from xfuzzy_rrt.training.ga import GAConfig
-    from xfuzzy_rrt.training.run import TrainJob, load_training_scenarios, run_training
+    import dataclasses
 
+    from xfuzzy_rrt.errors import InputError
+    from xfuzzy_rrt.training.ga import GAConfig
+    from xfuzzy_rrt.training.run import (
+        TrainJob,
+        load_training_scenarios,
+        resolve_seed_rulebooks,
+        run_training,
+    )
+
+    if workers is not None and workers < 1:
+        raise InputError("--workers", f"must be >= 1, got {workers}")
     from xfuzzy_rrt.training.run import baselines
 
     scenarios = load_training_scenarios(scenario)
@@ -121,9 +132,13 @@ def train(
         fitness=fitness, baseline=base,
         validation=tuple((t.scenario.name, t.sha256) for t in held_out), validation_baseline=v_base,
     )
+    seeds = resolve_seed_rulebooks(seed_rulebook, config.init, config.bounds)
+    config = dataclasses.replace(config, seed_rulebooks=tuple((s.rulebook.name, s.sha256)
+                                                              for s in seeds))
     job = TrainJob(config=config, scenarios=scenarios, out=out, resume=resume, workers=workers,
                    scheduler=scheduler, name=name, scenario_args=[str(p) for p in scenario],
-                   validation=held_out, validation_args=[str(p) for p in validation_scenario])
+                   validation=held_out, validation_args=[str(p) for p in validation_scenario],
+                   seed_rulebooks=seeds)
     progress = _Progress(generations)
     try:
         result = run_training(job, on_start=progress.start, on_generation=progress.generation,

@@ -12,13 +12,8 @@ Two independent measurements:
 - ``certified``: every vertex within the joint limits and every segment accepted by the
   certified check :func:`~xfuzzy_rrt.geometry.collision.edge_free` (conservative advancement,
   same ``margin`` as the planners). This is the yes/no the planners themselves are held to.
-- ``penetration_m``: a dense scan of every segment with *signed* exact distances. Samples are
-  spaced so that no point of the arm moves more than ``scan_step_m`` (0.1 mm) between two of
-  them, using the same motion bound ``M = max_k M_k`` as the certified check (see
-  ``collision.py``); where the clearance ``c`` exceeds that step the scan jumps by ``c / M``
-  instead, which provably skips no contact. At each sample the signed clearance is ``min over
-  links and obstacles of (signed distance - link_radius)`` and the penetration is
-  ``max(0, -signed clearance)``; the path's value is the maximum over all samples.
+- ``min_clearance_m`` / ``penetration_m``: the exact smallest *signed* clearance over every
+  configuration on the path (below), and the depth ``max(0, -min_clearance_m)``.
 
 The distance is *signed* so that the depth does not saturate once a link's centre line touches
 an obstacle (the unsigned clearance used for planning bottoms out at ``-link_radius``). Inside,
@@ -27,6 +22,18 @@ the obstacle: for a circle ``dist(centre, segment) - r``; for a box the smallest
 three separating axes of a segment and a rectangle (x, y and the segment's normal), which is
 exact for two convex polygons in the plane (separating axis theorem). Outside, it is the
 ordinary exact distance, so the two checks agree on every free configuration.
+
+``min_clearance_m`` is the smallest of these signed clearances over the whole path (negative:
+the exact penetration depth), found by Lipschitz branch and bound instead of a scan. Along a
+segment the signed clearance ``c(s)`` changes by at most ``M`` per unit ``s`` (``M = max_k
+M_k``, the motion bound of the certified check in ``collision.py``: no point of any link moves farther, and a signed distance to a convex obstacle
+moves no more than the segment does), so on an interval ``[s0, s1]`` with end values
+``c0, c1`` nothing is smaller than ``(c0 + c1 - M (s1 - s0)) / 2``. Intervals whose bound
+cannot beat the best value seen by more than ``MIN_CLEARANCE_TOL_M`` (0.1 um) are dropped,
+the others are halved (per link, with that link's own bound ``M_k``, which is tighter). The
+value returned is an exact distance at a real configuration on the path (``min_config_deg``),
+and no configuration on the path is closer by more than 0.1 um.
+``penetration_m`` is ``max(0, -min_clearance_m)``.
 """
 
 from __future__ import annotations
@@ -46,8 +53,14 @@ from xfuzzy_rrt.geometry.collision import (
     within_limits,
 )
 
-#: Largest motion (metres) of any point of the arm between two samples of the penetration scan.
-SCAN_STEP_M = 1e-4
+#: The exact minimum clearance along a path is bracketed to within this (metres): 0.1 um, a
+#: tenth of the certification margin. (1 nm costs ~8x the distance evaluations near smooth
+#: minima, where the Lipschitz bound converges slowly.)
+MIN_CLEARANCE_TOL_M = 1e-7
+#: Distance evaluations per path after which the branch and bound stops refining and reports
+#: its proven lower bound instead (only reached when the clearance stays within the tolerance of its
+#: minimum over a long stretch, e.g. a link turning about the centre of a circle).
+MIN_CLEARANCE_MAX_EVALS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -63,6 +76,30 @@ class PathCheck:
     certified: bool
     penetration_m: float
     worst_segment: int
+    #: Exact smallest signed clearance along the path (``inf`` without obstacles, ``nan``
+    #: without a path); negative values are penetration depths.
+    min_clearance_m: float = math.nan
+    #: Where it occurs: the segment (``path[i] -> path[i + 1]``; 0 for a one-point path) and
+    #: the configuration in degrees. ``-1`` / ``()`` when there is no such place.
+    min_segment: int = -1
+    min_config_deg: tuple[float, ...] = ()
+    #: First path vertex outside the joint limits (``-1``: none).
+    limits_vertex: int = -1
+
+    def describe(self) -> str:
+        """One sentence on why the path is not certified (empty string when it is)."""
+        if self.certified:
+            return ""
+        if self.min_segment < 0 and self.limits_vertex < 0 and self.worst_segment < 0:
+            return "no path to certify"
+        q = ", ".join(f"{v:.6g}" for v in self.min_config_deg)
+        if self.penetration_m > 0.0:
+            return (f"segment {self.worst_segment} penetrates an obstacle "
+                    f"{self.penetration_m * 1e3:.4g} mm deep at q = ({q}) deg")
+        if self.limits_vertex >= 0:
+            return f"vertex {self.limits_vertex} is outside the joint limits"
+        return (f"segment {self.worst_segment} does not pass the certified check (smallest "
+                f"clearance {self.min_clearance_m * 1e6:.4g} um at q = ({q}) deg)")
 
 
 @nb.njit(cache=True, nogil=True)
@@ -145,42 +182,162 @@ def motion_bound(links, qa_deg, qb_deg):
 
 
 @nb.njit(cache=True, nogil=True)
-def segment_penetration(links, base, radius, obstacles, qa, qb, step_m):
-    """Deepest penetration found on ``qa -> qb``, no arm point moving > ``step_m`` per sample.
-
-    Where the signed clearance ``c`` is larger than ``step_m`` the scan jumps ahead by
-    ``c / M`` (no point can reach an obstacle sooner, the argument of the certified check), so
-    a free segment costs a few dozen distance evaluations instead of thousands; elsewhere it
-    advances by ``step_m / M``.
-    """
-    m = motion_bound(links, qa, qb)
-    q = np.empty(qa.shape[0], dtype=np.float64)
-    q[:] = qa
-    worst = 0.0
-    s = 0.0
-    while True:
-        c = signed_clearance_kernel(links, base, radius, obstacles, q)
-        if -c > worst:
-            worst = -c
-        if s >= 1.0 or m <= 0.0:
-            return worst
-        s += max(c, step_m) / m
-        if s >= 1.0:
-            s = 1.0
-            q[:] = qb
-        else:
-            for d in range(qa.shape[0]):
-                q[d] = qa[d] + s * (qb[d] - qa[d])
+def _link_clearances(links, base, radius, obstacles, q_deg, out):
+    """``out[k]``: smallest signed clearance of link ``k`` to any obstacle; returns their min."""
+    best = np.inf
+    x = base[0]
+    y = base[1]
+    theta = 0.0
+    for k in range(links.shape[0]):
+        theta += math.radians(q_deg[k])
+        nx = x + links[k] * math.cos(theta)
+        ny = y + links[k] * math.sin(theta)
+        ck = np.inf
+        for o in range(obstacles.shape[0]):
+            d = signed_segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - radius
+            if d < ck:
+                ck = d
+        out[k] = ck
+        if ck < best:
+            best = ck
+        x = nx
+        y = ny
+    return best
 
 
 @nb.njit(cache=True, nogil=True)
-def certify_kernel(links, base, radius, obstacles, limits, path, margin, step_m):
-    """``(certified, worst penetration, its segment, first uncertified segment)``."""
+def _segment_min(links, base, radius, obstacles, qa, qb, ca, cb, tol, best, best_s,
+                 budget, stack_s, stack_c, q, cm):
+    """Branch and bound on one segment (see :func:`min_clearance_kernel`).
+
+    ``ca``/``cb`` are the per-link clearances at the ends. Returns ``(best, s of best, whether
+    best improved, evaluations used, lower bound of intervals dropped unrefined)``.
+    """
+    nl = links.shape[0]
+    m = np.empty(nl, dtype=np.float64)
+    p0 = np.empty(nl, dtype=np.float64)
+    p1 = np.empty(nl, dtype=np.float64)
+    for k in range(nl):
+        m[k] = link_motion_bound(links, qa, qb, k)
+    floor = np.inf
+    improved = False
+    evals = 0
+    depth_max = stack_s.shape[0]
+    stack_s[0, 0] = 0.0
+    stack_s[0, 1] = 1.0
+    stack_c[0, 0, :] = ca
+    stack_c[0, 1, :] = cb
+    top = 1
+    while top > 0:
+        top -= 1
+        s0 = stack_s[top, 0]
+        s1 = stack_s[top, 1]
+        h = s1 - s0
+        # Per link k, c_k is M_k-Lipschitz in s: nothing on [s0, s1] is below this.
+        lb = np.inf
+        for k in range(nl):
+            v = 0.5 * (stack_c[top, 0, k] + stack_c[top, 1, k] - m[k] * h)
+            if v < lb:
+                lb = v
+        if lb >= best - tol:
+            continue
+        sm = 0.5 * (s0 + s1)
+        if evals >= budget or top + 2 > depth_max or not (s0 < sm < s1):
+            if lb < floor:
+                floor = lb
+            continue
+        for d in range(q.shape[0]):
+            q[d] = qa[d] + sm * (qb[d] - qa[d])
+        c = _link_clearances(links, base, radius, obstacles, q, cm)
+        evals += 1
+        if c < best:
+            best = c
+            best_s = sm
+            improved = True
+        lo0 = np.inf
+        lo1 = np.inf
+        for k in range(nl):
+            p0[k] = stack_c[top, 0, k]
+            p1[k] = stack_c[top, 1, k]
+            lo0 = min(lo0, p0[k])
+            lo1 = min(lo1, p1[k])
+        # Two children; the one by the lower end is pushed last, so it is explored first.
+        left = top + 1 if lo0 <= lo1 else top
+        right = top if lo0 <= lo1 else top + 1
+        stack_s[left, 0] = s0
+        stack_s[left, 1] = sm
+        stack_s[right, 0] = sm
+        stack_s[right, 1] = s1
+        for k in range(nl):
+            stack_c[left, 0, k] = p0[k]
+            stack_c[left, 1, k] = cm[k]
+            stack_c[right, 0, k] = cm[k]
+            stack_c[right, 1, k] = p1[k]
+        top += 2
+    return best, best_s, improved, evals, floor
+
+
+@nb.njit(cache=True, nogil=True)
+def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals):
+    """Exact smallest signed clearance along ``path`` by Lipschitz branch and bound.
+
+    Returns ``(value, segment, s, lower bound, distance evaluations)``: ``value`` is attained at ``path[segment] +
+    s (path[segment + 1] - path[segment])`` and no configuration on the path has a signed
+    clearance below ``lower bound`` (``>= value - tol`` unless ``max_evals`` was reached).
+    Two passes: a coarse one (1 um) finds a near-optimal incumbent cheaply, so the fine one
+    only refines around the true minimum.
+    """
+    n = path.shape[0]
+    nl = links.shape[0]
+    if obstacles.shape[0] == 0 or n == 0:
+        return np.inf, -1, 0.0, np.inf, 0
+    cv = np.empty((n, nl), dtype=np.float64)
+    best = np.inf
+    best_seg = 0
+    best_s = 0.0
+    for i in range(n):
+        c = _link_clearances(links, base, radius, obstacles, path[i], cv[i])
+        if c < best:
+            best = c
+            if i < n - 1 or n == 1:
+                best_seg = i
+                best_s = 0.0
+            else:
+                best_seg = n - 2
+                best_s = 1.0
+    evals = n
+    floor = np.inf
+    depth_max = 200
+    stack_s = np.empty((depth_max, 2), dtype=np.float64)
+    stack_c = np.empty((depth_max, 2, nl), dtype=np.float64)
+    q = np.empty(path.shape[1], dtype=np.float64)
+    cm = np.empty(nl, dtype=np.float64)
+    for pass_tol in (max(tol, 1e-6), tol):
+        for i in range(n - 1):
+            got, s_got, improved, used, low = _segment_min(
+                links, base, radius, obstacles, path[i], path[i + 1], cv[i], cv[i + 1],
+                pass_tol, best, 0.0, max(0, max_evals - evals), stack_s, stack_c, q, cm)
+            evals += used
+            if improved:
+                best = got
+                best_seg = i
+                best_s = s_got
+            if pass_tol == tol and low < floor:
+                floor = low
+    lower = min(best - tol, floor)
+    return best, best_seg, best_s, lower, evals
+
+
+@nb.njit(cache=True, nogil=True)
+def certify_kernel(links, base, radius, obstacles, limits, path, margin):
+    """``(certified, first uncertified segment, first vertex outside the limits)``."""
     n = path.shape[0]
     certified = True
     first_bad = -1
-    worst = 0.0
-    worst_seg = -1
+    first_out = -1
+    for i in range(n):
+        if first_out < 0 and not within_limits(limits, path[i]):
+            first_out = i
     for i in range(n - 1):
         qa = path[i]
         qb = path[i + 1]
@@ -189,19 +346,14 @@ def certify_kernel(links, base, radius, obstacles, limits, path, margin, step_m)
             ok = edge_free(links, base, radius, obstacles, qa, qb, margin)
         if not ok:
             certified = False
-            if first_bad < 0:
-                first_bad = i
-        if obstacles.shape[0] > 0:
-            p = segment_penetration(links, base, radius, obstacles, qa, qb, step_m)
-            if p > worst:
-                worst = p
-                worst_seg = i
-    return certified, worst, worst_seg, first_bad
+            first_bad = i
+            break
+    return certified, first_bad, first_out
 
 
-def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M,
-                 scan_step_m: float = SCAN_STEP_M) -> PathCheck:
-    """Certify ``path_deg`` (``[n, dof]`` degrees) in ``arrays`` (a ``ScenarioArrays``).
+def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
+    """Certify ``path_deg`` (``[n, dof]`` degrees) in ``arrays`` (a ``ScenarioArrays``) and
+    measure its exact minimum clearance.
 
     An empty path is not certified (there is nothing to vouch for). A single configuration is
     certified when it is within the limits and keeps clearance above ``margin``.
@@ -214,21 +366,33 @@ def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M,
         raise InputError("path", f"must be an array of shape [n, {dof}], got {path.shape}")
     if not np.all(np.isfinite(path)):
         raise InputError("path", "contains non-finite angles")
-    if not (scan_step_m > 0.0 and math.isfinite(scan_step_m)):
-        raise InputError("scan_step_m", f"must be a positive number, got {scan_step_m!r}")
+    value, seg, s, lower, _ = min_clearance_kernel(
+        arrays.links, arrays.base, arrays.link_radius, arrays.obstacles, path,
+        MIN_CLEARANCE_TOL_M, MIN_CLEARANCE_MAX_EVALS)
+    value = float(value)
+    if float(lower) < value - MIN_CLEARANCE_TOL_M:
+        value = float(lower)  # budget reached: report the proven bound, never an optimistic one
+    where: tuple[float, ...] = ()
+    if seg >= 0:
+        qa = path[seg]
+        qb = path[min(seg + 1, path.shape[0] - 1)]
+        where = tuple(float(v) for v in qa + s * (qb - qa))
+    penetration = max(0.0, -value) if math.isfinite(value) else 0.0
     if path.shape[0] == 1:
         q = path[0]
-        c = float(signed_clearance_kernel(arrays.links, arrays.base, arrays.link_radius,
-                                          arrays.obstacles, q))
-        ok = bool(within_limits(arrays.limits_deg, q)) and c > margin
-        return PathCheck(certified=ok, penetration_m=max(0.0, -c), worst_segment=-1)
-    certified, worst, worst_seg, first_bad = certify_kernel(
+        inside = bool(within_limits(arrays.limits_deg, q))
+        ok = inside and value > margin
+        return PathCheck(certified=ok, penetration_m=penetration,
+                         worst_segment=0 if not ok and inside else -1,
+                         min_clearance_m=value, min_segment=seg, min_config_deg=where,
+                         limits_vertex=-1 if inside else 0)
+    certified, first_bad, first_out = certify_kernel(
         arrays.links, arrays.base, arrays.link_radius, arrays.obstacles, arrays.limits_deg,
-        path, float(margin), float(scan_step_m))
-    if worst <= 0.0:
-        worst_seg = first_bad
-    return PathCheck(certified=bool(certified), penetration_m=float(worst),
-                     worst_segment=int(worst_seg))
+        path, float(margin))
+    worst = int(seg) if penetration > 0.0 else (-1 if certified else int(first_bad))
+    return PathCheck(certified=bool(certified), penetration_m=float(penetration),
+                     worst_segment=worst, min_clearance_m=value, min_segment=int(seg),
+                     min_config_deg=where, limits_vertex=int(first_out))
 
 
 def signed_clearance(arrays, q_deg) -> float:

@@ -2,9 +2,9 @@
 
 A scenario is read once into frozen dataclasses; every later layer trusts it. So the loader is
 strict about what matters (types, signs, dimensions, that start and goal are reachable
-configurations) and names the file and key at fault in one line. Unknown keys are *not* fatal
-(generated files may carry extra metadata) but are recorded in ``Scenario.unknown_keys`` so the
-CLI can warn about likely typos.
+configurations) and names the file and key at fault in one line. An unknown key or table is an
+error too, with its line and the nearest known name (see :mod:`xfuzzy_rrt.strict`): a typo such
+as ``[[obstacle]]`` must never silently remove every obstacle.
 
 The format is described in ``shared/scenarios/FORMAT.md``: metres for lengths, degrees for joint
 angles, circles and axis-aligned boxes as obstacles, N links.
@@ -15,13 +15,14 @@ from __future__ import annotations
 import math
 import re
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from xfuzzy_rrt.errors import ScenarioError
+from xfuzzy_rrt.strict import toml_key_line, unknown_key_message
 
 CIRCLE = 0
 BOX = 1
@@ -75,7 +76,8 @@ class Scenario:
     obstacles: tuple[Obstacle, ...] = ()
     description: str = ""
     source: str = ""
-    unknown_keys: tuple[str, ...] = field(default=(), compare=False)
+    #: ``[safety] clearance_m``: the distance (m) every link should keep from every obstacle.
+    clearance_m: float = 0.0
 
     def arrays(self) -> "ScenarioArrays":
         """The flat arrays compiled code works on (see :class:`ScenarioArrays`)."""
@@ -121,20 +123,34 @@ class ScenarioArrays:
 # Loading and validation
 # --------------------------------------------------------------------------------------------
 
-_TOP_KEYS = {"name", "description", "arm", "start", "goal", "obstacles"}
-_ARM_KEYS = {"links", "base", "link_radius", "joint_limits_deg"}
-_CIRCLE_KEYS = {"type", "center", "radius"}
-_BOX_KEYS = {"type", "min", "max"}
+#: Known keys, spelt as the format writes them (tables in brackets), for the "did you mean".
+_TOP_KEYS = ("name", "description", "[arm]", "[safety]", "[start]", "[goal]", "[[obstacles]]")
+_ARM_KEYS = ("links", "base", "link_radius", "joint_limits_deg")
+_SAFETY_KEYS = ("clearance_m",)
+_CONFIG_KEYS = ("q_deg",)
+_CIRCLE_KEYS = ("type", "center", "radius")
+_BOX_KEYS = ("type", "min", "max")
 
 
 class _Reader:
     """Typed accessors that raise :class:`ScenarioError` naming the key."""
 
-    def __init__(self, file: str) -> None:
+    def __init__(self, file: str, text: str | None = None) -> None:
         self.file = file
+        self.text = text
 
     def fail(self, key: str, message: str) -> ScenarioError:
         return ScenarioError(self.file, key, message)
+
+    def only(self, data: dict[str, Any], known: tuple[str, ...], path: tuple = (),
+             where: str = "") -> None:
+        """Refuse the first key of ``data`` not in ``known`` (FILE:LINE, nearest known name)."""
+        bare = {k.strip("[]") for k in known}
+        for key in data:
+            if key not in bare:
+                line = toml_key_line(self.text, (*path, key)) if self.text is not None else None
+                file = f"{self.file}:{line}" if line is not None else self.file
+                raise ScenarioError(file, "", unknown_key_message(key, known, where))
 
     def table(self, data: dict[str, Any], key: str, path: str, required: bool = True) -> dict | None:
         if key not in data:
@@ -217,13 +233,17 @@ def load_scenario(path: str | Path) -> Scenario:
             raise ScenarioError(f"{file}:{m.group(1)}", "", f"TOML syntax error: {detail} "
                                 f"(column {m.group(2)})") from None
         raise ScenarioError(file, "", f"TOML syntax error: {message}") from None
-    return scenario_from_dict(data, file)
+    return scenario_from_dict(data, file, text)
 
 
-def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenario:
-    """Validate an already-parsed scenario mapping (the loader's second half)."""
-    r = _Reader(file)
-    unknown: list[str] = [k for k in data if k not in _TOP_KEYS]
+def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>",
+                       text: str | None = None) -> Scenario:
+    """Validate an already-parsed scenario mapping (the loader's second half).
+
+    ``text``, the TOML it was parsed from, lets an unknown key be reported with its line.
+    """
+    r = _Reader(file, text)
+    r.only(data, _TOP_KEYS)
 
     name = r.required(data, "name", "name")
     if not isinstance(name, str) or not name.strip():
@@ -233,7 +253,7 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenar
         raise r.fail("description", f"must be a string, got {_typename(description)}")
 
     arm_t = r.table(data, "arm", "arm")
-    unknown += [f"arm.{k}" for k in arm_t if k not in _ARM_KEYS]
+    r.only(arm_t, _ARM_KEYS, ("arm",), "[arm]")
     links_raw = r.required(arm_t, "links", "arm.links")
     links = r.lengths(links_raw, "arm.links")
     if not links:
@@ -266,10 +286,17 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenar
     arm = Arm(links=links, base=(base[0], base[1]), link_radius=link_radius,
               joint_limits_deg=tuple(limits))
 
+    safety_t = r.table(data, "safety", "safety", required=False) or {}
+    r.only(safety_t, _SAFETY_KEYS, ("safety",), "[safety]")
+    clearance_m = r.extent(r.number(safety_t.get("clearance_m", 0.0), "safety.clearance_m"),
+                           "safety.clearance_m")
+    if clearance_m < 0:
+        raise r.fail("safety.clearance_m", f"must be >= 0, got {clearance_m:g}")
+
     configs = {}
     for which in ("start", "goal"):
         t = r.table(data, which, which)
-        unknown += [f"{which}.{k}" for k in t if k != "q_deg"]
+        r.only(t, _CONFIG_KEYS, (which,), f"[{which}]")
         q_raw = r.required(t, "q_deg", f"{which}.q_deg")
         if isinstance(q_raw, list) and len(q_raw) != dof:
             raise r.fail(f"{which}.q_deg", f"must have one angle per link ({dof}), got {len(q_raw)}")
@@ -285,8 +312,9 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenar
         if not isinstance(o, dict):
             raise r.fail(key, f"must be a table, got {_typename(o)}")
         kind = r.required(o, "type", f"{key}.type")
+        where = f"[[obstacles]] #{i + 1} ({kind})"
         if kind == "circle":
-            unknown += [f"{key}.{k}" for k in o if k not in _CIRCLE_KEYS]
+            r.only(o, _CIRCLE_KEYS, ("obstacles", i), where)
             center = r.lengths(r.required(o, "center", f"{key}.center"), f"{key}.center", 2)
             radius = r.extent(r.number(r.required(o, "radius", f"{key}.radius"), f"{key}.radius"),
                               f"{key}.radius")
@@ -294,7 +322,7 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenar
                 raise r.fail(f"{key}.radius", f"must be > 0, got {radius:g}")
             obstacles.append(Circle(center=(center[0], center[1]), radius=radius))
         elif kind == "box":
-            unknown += [f"{key}.{k}" for k in o if k not in _BOX_KEYS]
+            r.only(o, _BOX_KEYS, ("obstacles", i), where)
             lo = r.lengths(r.required(o, "min", f"{key}.min"), f"{key}.min", 2)
             hi = r.lengths(r.required(o, "max", f"{key}.max"), f"{key}.max", 2)
             for axis, name_ in ((0, "x"), (1, "y")):
@@ -308,7 +336,7 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>") -> Scenar
     scenario = Scenario(
         name=name.strip(), arm=arm, start_deg=configs["start"], goal_deg=configs["goal"],
         obstacles=tuple(obstacles), description=description, source=file,
-        unknown_keys=tuple(unknown),
+        clearance_m=clearance_m,
     )
     _check_endpoints(scenario, r)
     return scenario

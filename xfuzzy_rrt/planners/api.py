@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+from dataclasses import dataclass
 from pathlib import Path
 
 from xfuzzy_rrt.errors import InputError
@@ -12,64 +14,132 @@ PLANNERS = ("rrt", "fuzzy-rrt")
 TRACE_SUFFIXES = (".parquet", ".csv")
 #: ``ompl:NAME`` runs OMPL's geometric planner NAME (optional extra; see planners/ompl_bridge.py).
 OMPL_PREFIX = "ompl:"
+#: ``fuzzy-rrt:NAME`` (a shipped rulebook) or ``fuzzy-rrt:DIR`` (a rulebook directory).
+FUZZY_PREFIX = "fuzzy-rrt:"
+
+
+@dataclass(frozen=True)
+class PlannerSpec:
+    """One planner as the user wrote it.
+
+    ``label`` is the text itself (``"fuzzy-rrt:paper"``): it names the planner in every table
+    so that several rulebooks can stand side by side. ``kind`` is ``rrt``, ``fuzzy-rrt`` or
+    ``ompl``; ``rulebook_dir`` is the directory a ``fuzzy-rrt:...`` label names (``None`` for
+    plain ``fuzzy-rrt``: the caller's rulebook or the shipped default).
+    """
+
+    label: str
+    kind: str
+    rulebook_dir: Path | None = None
 
 
 def is_known_planner(name: str) -> bool:
-    """A built-in planner name, or ``ompl:NAME`` (NAME is checked against OMPL when planning).
+    """A built-in planner name, ``fuzzy-rrt:...`` or ``ompl:NAME`` (the part after the colon
+    is checked by :func:`parse_planner`). Cheap and import-free, for argument parsing."""
+    return name in PLANNERS or any(name.startswith(p) and len(name) > len(p)
+                                   for p in (OMPL_PREFIX, FUZZY_PREFIX))
 
-    Cheap and import-free, for argument parsing; :func:`check_planner` does the full check.
+
+def shipped_rulebook_names() -> list[str]:
+    from xfuzzy_rrt.fuzzy.rulebook import list_rulebooks
+
+    return [p.name for p in list_rulebooks()]
+
+
+def rulebook_dir_of(arg: str, where: str) -> Path:
+    """The directory ``fuzzy-rrt:ARG`` names.
+
+    A bare word is a shipped rulebook (``general``, ``paper``, ...); anything with a path
+    separator, or starting with ``.`` or ``~``, is a directory. So ``fuzzy-rrt:paper`` never
+    silently picks up a folder that happens to be called ``paper`` in the current directory
+    (write ``fuzzy-rrt:./paper`` for that).
     """
-    return name in PLANNERS or (name.startswith(OMPL_PREFIX) and len(name) > len(OMPL_PREFIX))
+    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+
+    if "/" in arg or "\\" in arg or arg.startswith((".", "~")):
+        path = Path(arg).expanduser()
+        if not path.is_dir():
+            raise InputError(where, f"rulebook directory {arg!r} does not exist")
+        return path
+    path = rulebooks_dir() / arg
+    if not path.is_dir():
+        names = shipped_rulebook_names()
+        raise InputError(where, f"unknown rulebook {arg!r} in {FUZZY_PREFIX}{arg} (shipped: "
+                         f"{', '.join(names) or 'none'}; a directory needs a '/', e.g. "
+                         f"{FUZZY_PREFIX}./{arg})")
+    return path
+
+
+def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
+    """Validate a planner label fully, before any run: raises one InputError naming ``where``.
+
+    For ``ompl:NAME`` this imports OMPL, so a missing extra or an unknown OMPL planner fails
+    here with the same line it would give when planning. For ``fuzzy-rrt:NAME`` the rulebook
+    directory must exist (loading it, which validates every rule, is the caller's next step).
+    """
+    if name in PLANNERS:
+        return PlannerSpec(name, name)
+    if name.startswith(FUZZY_PREFIX) and len(name) > len(FUZZY_PREFIX):
+        return PlannerSpec(name, "fuzzy-rrt", rulebook_dir_of(name[len(FUZZY_PREFIX):], where))
+    if name.startswith(OMPL_PREFIX) and len(name) > len(OMPL_PREFIX):
+        from xfuzzy_rrt.planners.ompl_bridge import check_ompl_planner
+
+        check_ompl_planner(name, where)
+        return PlannerSpec(name, "ompl")
+    raise InputError(where, f"unknown planner {name!r} (expected one of "
+                     f"{', '.join(PLANNERS)}, {FUZZY_PREFIX}RULEBOOK or {OMPL_PREFIX}NAME)")
 
 
 def check_planner(name: str, where: str = "--planners") -> str:
-    """Validate a planner name fully, before any run: raises one InputError naming ``where``.
-
-    For ``ompl:NAME`` this imports OMPL, so a missing extra or an unknown OMPL planner fails
-    here with the same line it would give when planning.
-    """
-    if name in PLANNERS:
-        return name
-    if is_known_planner(name):
-        from xfuzzy_rrt.planners.ompl_bridge import check_ompl_planner
-
-        check_ompl_planner(name)
-        return name
-    raise InputError(where, f"unknown planner {name!r} (expected one of "
-                     f"{', '.join(PLANNERS)} or {OMPL_PREFIX}NAME)")
+    """:func:`parse_planner`, returning the label."""
+    return parse_planner(name, where).label
 
 
 def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None, seed: int = 0,
                   max_iter: int = 10_000, step_deg: float = 10.0, goal_bias: float = 0.05,
                   trace: bool = False, clearance_m: float | None = None) -> PlanResult:
-    """Plan ``scenario`` with the named planner.
+    """Plan ``scenario`` with the named planner (a label :func:`parse_planner` accepts).
 
     ``rulebook`` (fuzzy-rrt only) is a loaded rulebook, a directory path, or ``None`` for the
-    shipped default. ``step_deg``/``goal_bias`` configure plain RRT and the OMPL planners
-    (range and goal bias where they have one); Fuzzy-RRT takes both from its rulebook.
-    ``ompl:NAME`` runs OMPL's geometric planner NAME with our collision checker
-    (:func:`xfuzzy_rrt.planners.ompl_bridge.plan_ompl`; needs the optional 'ompl' extra).
+    shipped default, or for the one a ``fuzzy-rrt:NAME`` label names. ``step_deg``/``goal_bias``
+    configure plain RRT and the OMPL planners (range and goal bias where they have one);
+    Fuzzy-RRT takes both from its rulebook. ``ompl:NAME`` runs OMPL's geometric planner NAME
+    with our collision checker (:func:`xfuzzy_rrt.planners.ompl_bridge.plan_ompl`; needs the
+    optional 'ompl' extra). The result's ``planner`` is the label. ``clearance_m``: the
+    certified clearance in metres (default: the scenario's ``clearance_m``, else 0).
     """
-    if planner == "rrt":
+    spec = parse_planner(planner, "--planner")
+    if spec.kind != "fuzzy-rrt" and trace:
+        raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt")
+    if spec.kind == "rrt":
         from xfuzzy_rrt.planners.rrt import plan_rrt
 
-        if trace:
-            raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt")
         return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
                         goal_bias=goal_bias, clearance_m=clearance_m)
-    if planner == "fuzzy-rrt":
+    if spec.kind == "fuzzy-rrt":
         from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
 
-        return plan_fuzzy_rrt(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
-                               trace=trace, clearance_m=clearance_m)
-    if is_known_planner(planner):
-        from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
+        if spec.rulebook_dir is not None:
+            if rulebook is not None and not _same_rulebook(rulebook, spec.rulebook_dir):
+                raise InputError("--rulebook", f"conflicts with --planner {spec.label} (which "
+                                 "names its own rulebook); give only one")
+            rulebook = rulebook if rulebook is not None else spec.rulebook_dir
+        result = plan_fuzzy_rrt(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
+                                trace=trace, clearance_m=clearance_m)
+        return dataclasses.replace(result, planner=spec.label)
+    from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 
-        if trace:
-            raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt")
-        return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, step_deg=step_deg,
-                         goal_bias=goal_bias, clearance_m=clearance_m)
-    raise InputError("--planner", f"unknown planner {planner!r} (expected one of {', '.join(PLANNERS)})")
+    return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, step_deg=step_deg,
+                     goal_bias=goal_bias, clearance_m=clearance_m)
+
+
+def _same_rulebook(rulebook, directory: Path) -> bool:
+    """A loaded rulebook or a path that is the rulebook in ``directory``."""
+    if hasattr(rulebook, "sha256"):
+        from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached
+
+        return rulebook.sha256 == load_rulebook_cached(directory).sha256
+    return Path(rulebook).resolve() == Path(directory).resolve()
 
 
 def write_trace_checked(path: Path) -> None:

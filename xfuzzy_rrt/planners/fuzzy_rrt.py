@@ -102,6 +102,32 @@ def _interval(lo_raw, hi_raw, offset, limit_lo, limit_hi):
     return lo, hi
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def record_iteration(row, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample, tr_nearest,
+                     tr_new, tr_outcome, tr_node, tr_tree, from_node, x, y, box_lo0, box_hi0,
+                     box_lo1, box_hi1, goal_sampled, sx, sy, nearest_node, q_new, outcome,
+                     new_index, tree_size):
+    """Write trace row *row* (shared by every Fuzzy-RRT kernel, so traces mean one thing)."""
+    tr_from[row] = from_node
+    for k in range(x.shape[0]):
+        tr_x[row, k] = x[k]
+    for k in range(y.shape[0]):
+        tr_y[row, k] = y[k]
+    tr_box[row, 0] = box_lo0
+    tr_box[row, 1] = box_hi0
+    tr_box[row, 2] = box_lo1
+    tr_box[row, 3] = box_hi1
+    tr_goal_sampled[row] = goal_sampled
+    tr_sample[row, 0] = sx
+    tr_sample[row, 1] = sy
+    tr_nearest[row] = nearest_node
+    tr_new[row, 0] = q_new[0]
+    tr_new[row, 1] = q_new[1]
+    tr_outcome[row] = outcome
+    tr_node[row] = new_index
+    tr_tree[row] = tree_size
+
+
 @nb.njit(cache=True, nogil=True)
 def fuzzy_rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, max_iter,
                      knots, consts, bounds_mode, min_step, margin,
@@ -170,26 +196,10 @@ def fuzzy_rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, 
                                     nodes, parent, cell_next, cell_head, meta, grid, current,
                                     sx, sy, step, q_near, q_new)
         if record:
-            tr_from[row] = from_node
-            tr_x[row, 0] = x[0]
-            tr_x[row, 1] = x[1]
-            tr_x[row, 2] = x[2]
-            tr_x[row, 3] = x[3]
-            for k in range(N_OUTPUTS):
-                tr_y[row, k] = y[k]
-            tr_box[row, 0] = lo0
-            tr_box[row, 1] = hi0
-            tr_box[row, 2] = lo1
-            tr_box[row, 3] = hi1
-            tr_goal_sampled[row] = goal_sampled
-            tr_sample[row, 0] = sx
-            tr_sample[row, 1] = sy
-            tr_nearest[row] = current
-            tr_new[row, 0] = q_new[0]
-            tr_new[row, 1] = q_new[1]
-            tr_outcome[row] = outcome
-            tr_node[row] = new_index
-            tr_tree[row] = meta[0]
+            record_iteration(row, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample,
+                             tr_nearest, tr_new, tr_outcome, tr_node, tr_tree, from_node, x, y,
+                             lo0, hi0, lo1, hi1, goal_sampled, sx, sy, current, q_new, outcome,
+                             new_index, meta[0])
         if outcome == GOAL_REACHED:
             return True, it, new_index
     return False, max_iter, -1
@@ -260,8 +270,10 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     wall = time.perf_counter() - t0
     n = int(tree.meta[0])
     path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, 2))
-    result = PlanResult(
-        scenario=scenario.name, planner="fuzzy-rrt", seed=int(seed), success=bool(ok),
+    from xfuzzy_rrt.planners.result import certified_result  # certifies the path (found -> success)
+
+    result = certified_result(
+        a, margin, bool(ok), scenario=scenario.name, planner="fuzzy-rrt", seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),

@@ -39,6 +39,7 @@ from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_OUTPUTS
 from xfuzzy_rrt.geometry.collision import clearance_kernel
 from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.fuzzy_rrt import record_iteration
 from xfuzzy_rrt.planners.result import ACCEPTED, EDGE_BLOCKED, GOAL_REACHED, NODE_IN_COLLISION
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.tree import add_node, nearest
@@ -163,24 +164,10 @@ def goal_frame_kernel(links, base, radius, obstacles, limits, start, goal, seed,
                 best = d_new
                 stagnation = 0.0
         if record:
-            tr_from[row] = from_node
-            for k in range(4):
-                tr_x[row, k] = x[k]
-            for k in range(N_OUTPUTS):
-                tr_y[row, k] = y[k]
-            tr_box[row, 0] = bx0
-            tr_box[row, 1] = bx1
-            tr_box[row, 2] = by0
-            tr_box[row, 3] = by1
-            tr_goal_sampled[row] = goal_sampled
-            tr_sample[row, 0] = sx
-            tr_sample[row, 1] = sy
-            tr_nearest[row] = current
-            tr_new[row, 0] = q_new[0]
-            tr_new[row, 1] = q_new[1]
-            tr_outcome[row] = outcome
-            tr_node[row] = new_index
-            tr_tree[row] = meta[0]
+            record_iteration(row, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample,
+                             tr_nearest, tr_new, tr_outcome, tr_node, tr_tree, from_node, x, y,
+                             bx0, bx1, by0, by1, goal_sampled, sx, sy, current, q_new, outcome,
+                             new_index, meta[0])
         if outcome == GOAL_REACHED:
             return True, it, new_index
     return False, max_iter, -1

@@ -37,9 +37,10 @@ up exactly as our planners are (``plan_scenario(..., planner="ompl:RRTConnect")`
 - **Motion validation: OMPL's own** (``DiscreteMotionValidator`` at OMPL's default resolution,
   1 % of the space's extent, about 5.1° for ±180° limits, unless ``validity_resolution`` is
   given). That is deliberate: OMPL checks an edge by sampling it, so its raw path is then put
-  through :func:`~xfuzzy_rrt.geometry.path_check.certify_path` and ``params`` carries
-  ``certified``, ``penetration_m`` and ``worst_segment``: a grazing OMPL path is reported, never
-  silently accepted.
+  through :func:`~xfuzzy_rrt.geometry.path_check.certify_path` like every planner's
+  (:func:`~xfuzzy_rrt.planners.result.certified_result`): ``found`` is OMPL's exact solution,
+  ``success`` needs ``certified`` too, and a grazing path reports where and how deep it goes
+  (``violation``, ``penetration_m``, ``min_clearance_m``), never silently accepted.
 - **Raw path**: the path is the planner's own, not simplified by OMPL (shortening is ours and
   certified: :mod:`xfuzzy_rrt.planners.shortcut`).
 
@@ -72,10 +73,9 @@ from numba import carray
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, config_free, segment_free
-from xfuzzy_rrt.geometry.path_check import certify_path
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_max_iter, check_planar_2dof, check_positive
-from xfuzzy_rrt.planners.result import PlanResult, path_cost_deg
+from xfuzzy_rrt.planners.result import PlanResult, certified_result, path_cost_deg
 
 OMPL_PREFIX = "ompl:"
 MISSING_EXTRA = "ompl:* planners need the optional 'ompl' extra: pip install -e '.[ompl]'"
@@ -94,20 +94,21 @@ UNSUPPORTED = {
 }
 
 
-def import_ompl():
-    """``(ompl.base, ompl.geometric, ompl.util)`` or one clear InputError naming the extra."""
+def import_ompl(where: str = "--planners"):
+    """``(ompl.base, ompl.geometric, ompl.util)`` or one clear InputError naming the extra
+    (and the option, ``where``, that asked for an OMPL planner)."""
     try:
         from ompl import base as ob
         from ompl import geometric as og
         from ompl import util as ou
     except ImportError:
-        raise InputError("--planners", MISSING_EXTRA) from None
+        raise InputError(where, MISSING_EXTRA) from None
     return ob, og, ou
 
 
-def ompl_planner_names() -> tuple[str, ...]:
+def ompl_planner_names(where: str = "--planners") -> tuple[str, ...]:
     """Geometric planners this OMPL build exposes and ``ompl:NAME`` accepts (not UNSUPPORTED)."""
-    ob, og, _ = import_ompl()
+    ob, og, _ = import_ompl(where)
     names = []
     for name in dir(og):
         obj = getattr(og, name)
@@ -117,15 +118,16 @@ def ompl_planner_names() -> tuple[str, ...]:
     return tuple(sorted(names))
 
 
-def check_ompl_planner(name: str) -> str:
-    """The bare OMPL planner name of ``ompl:NAME`` (or ``NAME``); InputError if unknown."""
+def check_ompl_planner(name: str, where: str = "--planners") -> str:
+    """The bare OMPL planner name of ``ompl:NAME`` (or ``NAME``); InputError naming ``where``
+    (the option the name came from) if unknown."""
     bare = name[len(OMPL_PREFIX):] if name.startswith(OMPL_PREFIX) else name
-    known = ompl_planner_names()
+    known = ompl_planner_names(where)
     if bare in UNSUPPORTED:
-        raise InputError("--planners", f"OMPL planner {bare!r} is not supported: "
+        raise InputError(where, f"OMPL planner {bare!r} is not supported: "
                          f"{UNSUPPORTED[bare]} (supported: {', '.join(known)})")
     if bare not in known:
-        raise InputError("--planners", f"unknown OMPL planner {bare!r} (known: {', '.join(known)})")
+        raise InputError(where, f"unknown OMPL planner {bare!r} (known: {', '.join(known)})")
     return bare
 
 
@@ -205,8 +207,8 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
     space's extent (``None``: OMPL's default 0.01). See the module docstring for everything
     else; the returned ``PlanResult.planner`` is ``"ompl:NAME"``.
     """
-    ob, og, ou = import_ompl()
-    bare = check_ompl_planner(planner)
+    ob, og, ou = import_ompl("--planner")
+    bare = check_ompl_planner(planner, "--planner")
     check_planar_2dof(scenario)
     check_max_iter(max_iter)
     check_positive("step_deg", step_deg)
@@ -321,7 +323,6 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
     finally:
         ou.setLogLevel(previous_level)
 
-    check = certify_path(a, path, margin) if exact else None
     params = {
         "ompl_planner": bare,
         "ompl_version": _ompl_version(),
@@ -339,17 +340,18 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
         "margin_m": float(margin),
         "goal_threshold_deg": GOAL_THRESHOLD_DEG,
         "goal_appended": goal_appended,
-        "certified": None if check is None else check.certified,
-        "penetration_m": None if check is None else check.penetration_m,
-        "worst_segment": None if check is None else check.worst_segment,
     }
     if failure is not None:
         params["failure"] = failure
-    return PlanResult(
-        scenario=scenario.name, planner=OMPL_PREFIX + bare, seed=int(seed), success=exact,
+    result = certified_result(
+        a, margin, exact, scenario=scenario.name, planner=OMPL_PREFIX + bare, seed=int(seed),
         iterations=iterations, nodes=n, cost_deg=path_cost_deg(path) if exact else None,
         wall_s=wall, path_deg=path, tree_nodes_deg=tree, tree_parent=parent, params=params,
     )
+    # Kept in params too for readers of older result files; the top-level fields are the truth.
+    params["certified"] = result.certified if exact else None
+    params["penetration_m"] = result.penetration_m if exact else None
+    return result
 
 
 def _ompl_version() -> str:

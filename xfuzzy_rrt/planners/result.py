@@ -4,6 +4,13 @@
 counting whether it was accepted or rejected (``max_iter`` on failure). ``nodes`` is the tree
 size at the end, start and (on success) goal included. ``cost_deg`` is the joint-space length of
 the path in degrees (``None`` on failure).
+
+``found`` says the planner returned a path; ``certified`` that every segment of it passes the
+certified check (:func:`xfuzzy_rrt.geometry.path_check.certify_path`, whatever planner made
+it); ``success`` is derived, ``found and certified``, so no result can call a colliding path a
+success. ``min_clearance_m`` is the exact smallest signed distance between any link capsule
+and any obstacle along the path (negative: penetration depth; ``None`` without a path, ``inf``
+without obstacles -- ``null`` in JSON either way). Planners build results through :func:`certified_result`.
 """
 
 from __future__ import annotations
@@ -43,7 +50,6 @@ class PlanResult:
     scenario: str
     planner: str
     seed: int
-    success: bool
     iterations: int
     nodes: int
     cost_deg: float | None
@@ -55,6 +61,22 @@ class PlanResult:
     rulebook_sha256: str | None = None
     params: dict[str, Any] = field(default_factory=dict)
     trace: Any = field(default=None, repr=False)
+    found: bool = False
+    certified: bool = False
+    min_clearance_m: float | None = None
+    penetration_m: float | None = None
+    #: Why a found path is not certified (one sentence naming the segment, configuration and
+    #: depth); ``None`` when certified or when nothing was found.
+    violation: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.certified and not self.found:
+            raise ValueError("a result without a path cannot be certified")
+
+    @property
+    def success(self) -> bool:
+        """A path was found *and* it is certified collision-free."""
+        return bool(self.found and self.certified)
 
     def to_json_dict(self) -> dict[str, Any]:
         """The SPEC.md result object (plus ``params``), with plain Python numbers."""
@@ -65,11 +87,38 @@ class PlanResult:
             "rulebook": self.rulebook,
             "rulebook_sha256": self.rulebook_sha256,
             "seed": int(self.seed),
-            "success": bool(self.success),
+            "success": self.success,
             "iterations": int(self.iterations),
             "nodes": int(self.nodes),
             "cost_deg": cost,
+            "found": bool(self.found),
+            "certified": bool(self.certified),
+            "min_clearance_m": _finite_or_none(self.min_clearance_m),
+            "penetration_m": _finite_or_none(self.penetration_m),
             "wall_s": float(self.wall_s),
             "path_deg": [[float(a) for a in row] for row in self.path_deg],
             "params": dict(self.params),
         }
+
+
+def _finite_or_none(x: float | None) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def certified_result(arrays, margin: float, found: bool, **fields: Any) -> PlanResult:
+    """A :class:`PlanResult` whose path (``fields["path_deg"]``) has been certified.
+
+    Every planner ends here, so ``found``/``certified``/``min_clearance_m`` mean the same for
+    RRT, Fuzzy-RRT and OMPL's planners: the path is put through the exact check after the timed
+    planning (``wall_s`` does not include it).
+    """
+    from xfuzzy_rrt.geometry.path_check import certify_path
+
+    path = np.asarray(fields["path_deg"], dtype=np.float64)
+    if not found or path.size == 0:
+        return PlanResult(found=bool(found) and path.size > 0, **fields)
+    check = certify_path(arrays, path, margin)
+    return PlanResult(found=True, certified=check.certified,
+                      min_clearance_m=float(check.min_clearance_m),
+                      penetration_m=float(check.penetration_m),
+                      violation=None if check.certified else check.describe(), **fields)

@@ -21,7 +21,7 @@ from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_max_iter, check_planar_2dof, check_positive
 from xfuzzy_rrt.planners.extend import extend
-from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
+from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path, nearest
 
@@ -78,8 +78,8 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
     wall = time.perf_counter() - t0
     n = int(tree.meta[0])
     path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, 2))
-    return PlanResult(
-        scenario=scenario.name, planner="rrt", seed=int(seed), success=bool(ok),
+    return certified_result(
+        a, margin, bool(ok), scenario=scenario.name, planner="rrt", seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),

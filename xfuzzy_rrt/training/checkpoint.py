@@ -20,12 +20,17 @@ import numpy as np
 
 from xfuzzy_rrt.atomic import atomic_path
 from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.strict import unknown_key_message
 from xfuzzy_rrt.training.ga import GAConfig, TrainState
 from xfuzzy_rrt.training.genome import N_GENES
 
 FORMAT = "xfuzzy-rrt-train-checkpoint"
 VERSION = 1
 FILE_NAME = "state.npz"
+#: Every array a checkpoint holds, and every key of its ``meta`` document: anything else is
+#: refused (a file this version did not write must not be half-understood).
+ARRAYS = ("meta", "population", "hall_of_fame", "last_fitness", "last_population")
+META_KEYS = ("format", "version", "fingerprint", "generation", "done", "rng_state", "history")
 
 
 def checkpoint_file(directory: Path) -> Path:
@@ -71,16 +76,24 @@ def load_checkpoint(directory: Path, config: GAConfig) -> TrainState:
     try:
         data = path.read_bytes()
         with np.load(io.BytesIO(data), allow_pickle=False) as z:
+            for name in z.files:
+                if name not in ARRAYS:
+                    raise InputError(where, unknown_key_message(name, ARRAYS, "the arrays"))
             meta = json.loads(str(z["meta"][()]))
             population = np.array(z["population"], dtype=np.float64)
             hof = np.array(z["hall_of_fame"], dtype=np.float64)
             last_fit = np.array(z["last_fitness"]) if "last_fitness" in z.files else None
             last_pop = np.array(z["last_population"]) if "last_population" in z.files else None
+    except InputError:
+        raise
     except Exception as exc:  # noqa: BLE001 — any failure to parse untrusted bytes is "corrupt"
         # (numpy's header parser alone can raise ValueError, SyntaxError or tokenize.TokenError)
         raise InputError(where, f"corrupt checkpoint ({type(exc).__name__}: {exc})") from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise InputError(where, "not an xfuzzy-rrt training checkpoint")
+    for key in meta:
+        if key not in META_KEYS:
+            raise InputError(where, unknown_key_message(key, META_KEYS, "meta"))
     if meta.get("version") != VERSION:
         raise InputError(where, f"checkpoint version {meta.get('version')!r} is not supported "
                          f"(this version reads {VERSION})")

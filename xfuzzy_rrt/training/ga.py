@@ -25,8 +25,9 @@ Initialisation (``init="seeded"``, the default): a population of uniformly rando
 flat — measured on ``paper-reference``, random rule constants average out to a tiny sampling
 box and fail every run, so every individual scores -100 and selection has nothing to select.
 So the first generation holds rulebooks that already solve problems — the RRT-equivalent one
-(full box, bias 0.05, step 10°), goal-biased variants of it, the ``expert`` rulebook when its
-bounds meaning matches — and perturbations of them at several scales: small per-rule noise and
+(full box, bias 0.05, step 10°), goal-biased variants of it, the seed rulebooks (``train
+--seed-rulebook``; by default the shipped ``expert`` when its bounds meaning matches), whose
+SHA-256 are part of the configuration — and perturbations of them at several scales: small per-rule noise and
 whole-output shifts (which move a bound or the bias everywhere at once, the coarse direction a
 per-rule mutation cannot take). ``init="random"`` gives the paper-style uniform start for
 comparison.
@@ -85,6 +86,9 @@ class GAConfig:
     baseline: tuple[float, ...] = ()  # RRT median iterations per training scenario (log-ratio)
     validation: tuple[tuple[str, str], ...] = ()  # held-out scenarios that pick the final rulebook
     validation_baseline: tuple[float, ...] = ()
+    #: (name, sha256) of each seed rulebook of a seeded first generation, in order: the first
+    #: generation depends on them, so they are part of the fingerprint and of the provenance.
+    seed_rulebooks: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         from xfuzzy_rrt.errors import InputError
@@ -114,6 +118,8 @@ class GAConfig:
         need(self.init in ("seeded", "random"), "--init", f"must be seeded or random, got {self.init!r}")
         need(0 <= self.validation_runs <= 10_000, "--validation-runs", "must lie in [0, 10000]")
         need(len(self.scenarios) >= 1, "--scenario", "give at least one training scenario")
+        need(self.init == "seeded" or not self.seed_rulebooks, "--seed-rulebook",
+             "seed rulebooks are only used with --init seeded")
 
     #: Options that only say when to stop or how to choose at the end: a checkpoint may be
     #: resumed with other values (e.g. more generations), and the result is then exactly that
@@ -121,10 +127,14 @@ class GAConfig:
     STOPPING = ("generations", "target_fitness", "validation_runs")
     #: Options added after the first checkpoints were written: left out of the fingerprint
     #: while they keep their default, so older checkpoints still resume.
-    LATER = {"fitness": "paper", "baseline": (), "validation": (), "validation_baseline": ()}
+    LATER = {"fitness": "paper", "baseline": (), "validation": (), "validation_baseline": (),
+             "seed_rulebooks": ()}
 
     def fingerprint(self) -> str:
-        """SHA-256 of the options that shape the search (identifies a checkpoint's run)."""
+        """SHA-256 of the options that shape the search (identifies a checkpoint's run),
+        including the training scenarios' and the seed rulebooks' SHA-256. Options added later
+        are left out while they keep their default (absent rather than empty), so a run that
+        does not use them keeps the fingerprint it had before they existed and still resumes."""
         fields = {k: v for k, v in asdict(self).items() if k not in self.STOPPING
                   and not (k in self.LATER and v == self.LATER[k])}
         blob = json.dumps(fields, sort_keys=True, separators=(",", ":"))
@@ -160,13 +170,17 @@ GOAL_FRAME_SEEDS = (
 )
 
 
-def seed_genomes(bounds: str, expert=None) -> list[tuple[str, np.ndarray]]:
-    """Named genomes that already solve problems (see the module docstring)."""
+def seed_genomes(bounds: str, rulebooks=()) -> list[tuple[str, np.ndarray]]:
+    """Named genomes that already solve problems (see the module docstring): the built-in
+    constant ones, then each of ``rulebooks`` (which must mean what the training means:
+    the same bounds, or the goal-frame semantics)."""
     if bounds == "goal-frame":
         out = [(f"goal-frame-{i}", constant_outputs_genome(v, bounds))
                for i, v in enumerate(GOAL_FRAME_SEEDS)]
-        if expert is not None and expert.semantics.name == "goal-frame":
-            out.append((expert.name, encode(*expert.arrays(), bounds)))
+        for rb in rulebooks:
+            if rb.semantics.name != "goal-frame":
+                raise ValueError(f"seed rulebook {rb.name!r} is not a goal-frame rulebook")
+            out.append((rb.name, encode(*rb.arrays(), bounds)))
         return out
     full = (-180.0, 180.0, -180.0, 180.0)
     out = [("rrt-equivalent", constant_genome(0.05, full, 10.0))]
@@ -175,18 +189,29 @@ def seed_genomes(bounds: str, expert=None) -> list[tuple[str, np.ndarray]]:
     if bounds == "relative":
         for half in (30.0, 60.0, 90.0):
             out.append((f"window-{half:g}", constant_genome(0.2, (-half, half, -half, half), 10.0)))
-    if expert is not None and expert.semantics.name == "paper" and expert.bounds_mode == bounds:
-        knots, consts = expert.arrays()
-        out.append((expert.name, encode(knots, consts)))
+    for rb in rulebooks:
+        if rb.semantics.name != "paper" or rb.bounds_mode != bounds:
+            raise ValueError(f"seed rulebook {rb.name!r} has {rb.bounds_mode} bounds, the "
+                             f"training {bounds}")
+        knots, consts = rb.arrays()
+        out.append((rb.name, encode(knots, consts)))
     return out
 
 
-def initial_population(config: GAConfig, rng: np.random.Generator, expert=None) -> np.ndarray:
-    """The first generation ``[population, 3822]`` (deterministic given ``rng``)."""
+def initial_population(config: GAConfig, rng: np.random.Generator, rulebooks=()) -> np.ndarray:
+    """The first generation ``[population, 3822]`` (deterministic given ``rng``).
+
+    ``rulebooks`` are the seed rulebooks; they must be exactly those ``config.seed_rulebooks``
+    names (same order, same SHA-256), so the population depends only on what is recorded.
+    """
     n = config.population
+    given = tuple((rb.name, rb.sha256) for rb in rulebooks)
+    if given != tuple(tuple(x) for x in config.seed_rulebooks):
+        raise ValueError(f"seed rulebooks {given} are not the configuration's "
+                         f"{config.seed_rulebooks}")
     if config.init == "random":
         return rng.random((n, N_GENES))
-    seeds = [g for _, g in seed_genomes(config.bounds, expert)]
+    seeds = [g for _, g in seed_genomes(config.bounds, rulebooks)]
     pop = np.empty((n, N_GENES))
     k = min(len(seeds), n)
     pop[:k] = np.array(seeds[:k])
@@ -306,9 +331,9 @@ class TrainResult:
     state: TrainState
 
 
-def new_state(config: GAConfig, expert=None) -> TrainState:
+def new_state(config: GAConfig, rulebooks=()) -> TrainState:
     rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([config.seed, 0])))
-    pop = initial_population(config, rng, expert)
+    pop = initial_population(config, rng, rulebooks)
     return TrainState(generation=0, population=pop, rng_state=rng.bit_generator.state)
 
 
@@ -360,8 +385,9 @@ class Trainer:
             "success_rate": float(ok.mean()),
             "runs": runs,
             "runs_per_s": runs / wall if wall > 0 else float("nan"),
-            "validation_fitness": held_out,
         }
+        if self.validator is not None:
+            row["validation_fitness"] = held_out
         generation = state.generation + 1
         done = generation >= c.generations or fit[best] >= c.target_fitness
         rng = np.random.Generator(np.random.PCG64())

@@ -7,9 +7,11 @@ Output layout of ``--out DIR``::
     DIR/checkpoint/state.npz              the latest checkpoint (see .checkpoint)
 
 Everything in the rulebook — the six systems *and* the manifest — depends only on the training
-inputs (scenario files, options, ``--seed``), never on the worker count, the engine or an
-interruption: the manifest records a canonical command line rebuilt from the options (not the
-literal argv, which would differ with ``--workers`` or ``--resume``) and no wall-clock time.
+inputs (scenario files, seed rulebooks, options, ``--seed``), never on the worker count, the
+engine or an interruption: the manifest records a canonical command line rebuilt from the
+options (not the literal argv, which would differ with ``--workers`` or ``--resume``), the
+SHA-256 of every input file, the versions of the libraries the numbers depend on, and no
+wall-clock time.
 ``history.csv``'s ``wall_s`` and ``runs_per_s`` columns are the only measured (non-reproducible)
 numbers a training run writes.
 """
@@ -31,6 +33,12 @@ CHECKPOINT_DIR = "checkpoint"
 #: RRT runs per scenario (seeds 0..49) behind the log-ratio fitness's baseline.
 BASELINE_RUNS = 50
 HISTORY_FILE = "history.csv"
+#: The seed rulebook of ``--init seeded`` when no ``--seed-rulebook`` is given (shipped).
+DEFAULT_SEED_RULEBOOK = "expert"
+#: What a default seed rulebook is recorded as (``source``) in the manifest.
+PACKAGED = "packaged"
+#: Libraries whose versions a byte-exact rebuild of a trained rulebook depends on.
+VERSIONED = ("numpy", "numba", "pymoo", "scipy")
 
 
 @dataclass(frozen=True)
@@ -74,16 +82,83 @@ def load_training_scenarios(paths: list[Path]) -> list[TrainingScenario]:
     return items
 
 
+@dataclass(frozen=True)
+class SeedRulebook:
+    """A rulebook the seeded first generation starts from, and where it came from."""
+
+    source: str  # the --seed-rulebook value as given, or PACKAGED for the default
+    rulebook: object
+
+    @property
+    def sha256(self) -> str:
+        return self.rulebook.sha256
+
+
+def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str) -> list[SeedRulebook]:
+    """The seed rulebooks of a training run, loaded and checked.
+
+    ``paths`` are the ``--seed-rulebook`` values (``None``: not given). Under ``--init
+    seeded`` the default is the shipped ``expert`` rulebook when it means its bounds as
+    ``bounds`` (none otherwise: the paper's absolute setting starts from the built-in genomes
+    alone); a missing default or a given seed that does not exist, does not load or has the
+    other bounds meaning is an error, never silently dropped (the first generation would
+    change under the same recorded command).
+    """
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
+
+    if init != "seeded":
+        if paths:
+            raise InputError("--seed-rulebook", "seed rulebooks are only used with --init seeded")
+        return []
+    if not paths:
+        folder = rulebooks_dir() / DEFAULT_SEED_RULEBOOK
+        if not folder.is_dir():
+            raise InputError(str(folder), f"the default seed rulebook {DEFAULT_SEED_RULEBOOK!r} "
+                             "is missing; pass --seed-rulebook DIR or --init random")
+        rb = load_rulebook(folder)
+        return [SeedRulebook(PACKAGED, rb)] if rb.bounds_mode == bounds else []
+    out = []
+    for p in paths:
+        rb = load_rulebook(p)  # a missing or broken folder is the usual one-line error
+        if bounds == "goal-frame":
+            if rb.semantics.name != "goal-frame":
+                raise InputError(str(p), "seed rulebook is not a goal-frame rulebook, but "
+                                 "--bounds is goal-frame")
+        elif rb.semantics.name != "paper" or rb.bounds_mode != bounds:
+            raise InputError(str(p), f"seed rulebook has {rb.bounds_mode} bounds, but "
+                             f"--bounds is {bounds}")
+        out.append(SeedRulebook(str(p), rb))
+    return out
+
+
+def library_versions() -> dict[str, str]:
+    """Python and the libraries whose versions the byte-exact result depends on."""
+    import platform
+    from importlib import metadata
+
+    out = {"python": platform.python_version()}
+    for dist in VERSIONED:
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            out[dist] = "not installed"
+    return out
+
+
 def canonical_command(config: GAConfig, scenario_args: list[str], out: str,
+                      seed_args: list[str] | None = None,
                       validation_args: list[str] = ()) -> str:
     """The command that reproduces this training run (independent of workers and engine).
 
     ``scenario_args`` are the ``--scenario`` values as given (a folder stays a folder; the
-    manifest lists every file it held with its SHA-256).
+    manifest lists every file it held with its SHA-256); ``seed_args`` the ``--seed-rulebook``
+    values as given (none for the packaged default; the manifest records its SHA-256).
     """
     args = ["xfuzzy-rrt", "train"]
     for a in scenario_args:
         args += ["--scenario", a]
+    for a in seed_args or []:
+        args += ["--seed-rulebook", a]
     defaults = GAConfig(scenarios=(("x", "y"),))
     options = [("population", "--population"), ("generations", "--generations"),
                ("runs_per_eval", "--runs-per-eval"), ("target_fitness", "--target-fitness"),
@@ -116,9 +191,13 @@ def baselines(scenarios: list[TrainingScenario], max_iter: int) -> tuple[float, 
 
 
 def history_frame(history: list[dict]):
+    """One row per generation; ``validation_fitness`` only when the run has held-out scenarios
+    (a run without them writes exactly the columns it always did)."""
     import pandas as pd
 
-    return pd.DataFrame(history, columns=HISTORY_COLUMNS)
+    held_out = any("validation_fitness" in row for row in history)
+    return pd.DataFrame(history, columns=[c for c in HISTORY_COLUMNS
+                                          if c != "validation_fitness" or held_out])
 
 
 def write_history(path: Path, history: list[dict]) -> None:
@@ -138,6 +217,8 @@ class TrainJob:
     scenario_args: list[str] = field(default_factory=list)  # --scenario values as given
     validation: list[TrainingScenario] = field(default_factory=list)  # held-out scenarios
     validation_args: list[str] = field(default_factory=list)
+    #: the seed rulebooks (see resolve_seed_rulebooks); must match config.seed_rulebooks
+    seed_rulebooks: list[SeedRulebook] = field(default_factory=list)
     resume: bool = False
     workers: int | None = None
     scheduler: str | None = None
@@ -149,9 +230,11 @@ class TrainJob:
         return self.out / CHECKPOINT_DIR
 
     def check_out(self) -> None:
-        """Refuse to clobber another run: an existing checkpoint needs ``--resume``."""
+        """Refuse bad engine options and clobbering another run (a checkpoint needs --resume)."""
         from xfuzzy_rrt.training.checkpoint import checkpoint_file
 
+        if self.workers is not None and self.workers < 1:
+            raise InputError("--workers", f"must be >= 1, got {self.workers}")
         if self.out.exists() and not self.out.is_dir():
             raise InputError(str(self.out), "exists and is not a directory")
         has = checkpoint_file(self.checkpoint_dir).exists()
@@ -166,7 +249,6 @@ def run_training(job: TrainJob,
                  on_chunk: Callable[[int, int], None] | None = None,
                  on_phase: Callable[[str], None] | None = None) -> TrainResult:
     """Train (or resume), checkpointing every generation; write the rulebook at the end."""
-    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
     from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
     from xfuzzy_rrt.training.evaluate import Problem
     from xfuzzy_rrt.training.workers import make_evaluator
@@ -176,15 +258,9 @@ def run_training(job: TrainJob,
     if job.resume:
         state = load_checkpoint(job.checkpoint_dir, config)
     else:
-        expert = None
-        expert_dir = rulebooks_dir() / "expert"
-        if config.init == "seeded" and expert_dir.is_dir():
-            expert = load_rulebook(expert_dir)
-        state = new_state(config, expert)
+        state = new_state(config, [s.rulebook for s in job.seed_rulebooks])
     problems = [Problem.from_scenario(t.scenario) for t in job.scenarios]
     held_out = [Problem.from_scenario(t.scenario) for t in job.validation]
-    job.out.mkdir(parents=True, exist_ok=True)
-    _remove_stale_temporaries(job)
     history_path = job.out / HISTORY_FILE
 
     def checkpoint(row: dict, new) -> None:
@@ -193,6 +269,7 @@ def run_training(job: TrainJob,
         if on_generation:
             on_generation(row)
 
+    # the engines first: a bad --scheduler or --workers fails before any folder is made
     with contextlib.ExitStack() as stack:
         evaluator = stack.enter_context(make_evaluator(problems, config.bounds, config.max_iter,
                                                        job.workers, job.scheduler))
@@ -201,6 +278,8 @@ def run_training(job: TrainJob,
             validator = stack.enter_context(make_evaluator(held_out, config.bounds,
                                                            config.max_iter, job.workers,
                                                            job.scheduler))
+        job.out.mkdir(parents=True, exist_ok=True)
+        _remove_stale_temporaries(job)
         if on_start:
             on_start(evaluator.description, state.generation)
         if state.history:
@@ -242,7 +321,8 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
     provenance = {
         "kind": "ga",
         "command": canonical_command(c, job.scenario_args or [t.path for t in job.scenarios],
-                                     str(job.out), job.validation_args),
+                                     str(job.out), [s.source for s in job.seed_rulebooks
+                                                    if s.source != PACKAGED], job.validation_args),
         "algorithm": "generational GA: tournament selection, SBX crossover, polynomial and "
                      "term-block mutation, elitism (xfuzzy_rrt.training)",
         "package_version": __version__,
@@ -265,6 +345,9 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
         "fitness": c.fitness,
         "scenarios": [{"name": t.scenario.name, "file": t.path, "sha256": t.sha256}
                       for t in job.scenarios],
+        "seed_rulebooks": [{"name": s.rulebook.name, "source": s.source, "sha256": s.sha256}
+                           for s in job.seed_rulebooks],
+        "versions": library_versions(),
         **job.extra_provenance,
     }
     if c.fitness == "log-ratio":
@@ -286,5 +369,6 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
     return save_rulebook(rb, job.out)
 
 
-__all__ = ["TrainJob", "TrainingScenario", "canonical_command", "expand_scenarios",
-           "history_frame", "load_training_scenarios", "run_training"]
+__all__ = ["SeedRulebook", "TrainJob", "TrainingScenario", "canonical_command",
+           "expand_scenarios", "history_frame", "library_versions", "load_training_scenarios",
+           "resolve_seed_rulebooks", "run_training"]

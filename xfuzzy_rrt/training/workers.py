@@ -5,11 +5,19 @@ All three engines compute the same function, :func:`evaluate_chunk` (genes of a 
 order. Because each individual's runs depend only on its genes, the scenario and the seeds —
 never on which chunk it was in or which worker ran it — the result is identical, number for
 number, whatever the engine or the worker count (tested).
+
+Local workers die with the training process: a ``kill -9`` of ``train`` gives its workers no
+chance to be shut down, so each worker asks the kernel to kill it when its parent dies
+(``prctl(PR_SET_PDEATHSIG)`` on Linux). A ``--scheduler`` address is checked (syntax, then a
+plain TCP connection with a short timeout) before Dask is asked to connect, so a typo fails in
+a few seconds with one line instead of Dask's retry loop and its clean-up tracebacks.
 """
 
 from __future__ import annotations
 
 import os
+import signal
+import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Callable, Sequence
 
@@ -23,6 +31,10 @@ from xfuzzy_rrt.training.genome import decode
 CHUNKS_PER_WORKER = 4
 
 _PROBLEMS: list[Problem] | None = None  # set once per worker process by _init_worker
+#: Seconds to reach a Dask scheduler before giving up.
+CONNECT_TIMEOUT_S = 3.0
+#: prctl(2) option: the signal this process gets when its parent dies (linux/prctl.h).
+PR_SET_PDEATHSIG = 1
 
 
 def evaluate_chunk(genes: np.ndarray, problems: Sequence[Problem], bounds_mode: str,
@@ -32,8 +44,30 @@ def evaluate_chunk(genes: np.ndarray, problems: Sequence[Problem], bounds_mode: 
     return iterations_for(list(problems), knots, consts, bounds_mode, seeds, max_iter)
 
 
-def _init_worker(problems: list[Problem]) -> None:
+def die_with_parent(parent_pid: int) -> bool:
+    """Have the kernel SIGKILL this process when its parent dies (Linux); True if arranged.
+
+    Why: workers of a ``kill -9``-ed parent would otherwise keep computing, orphaned, until
+    their queue breaks. If the parent is already gone when this runs, exit at once.
+    """
+    if not sys.platform.startswith("linux"):
+        return False
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) != 0:
+            return False
+    except (OSError, AttributeError):
+        return False
+    if os.getppid() != parent_pid:  # the parent died before the request took effect
+        os._exit(1)
+    return True
+
+
+def _init_worker(problems: list[Problem], parent_pid: int) -> None:
     global _PROBLEMS
+    die_with_parent(parent_pid)
     _PROBLEMS = problems
     # load the compiled kernels now (from numba's cache) rather than inside the first task
     from xfuzzy_rrt.training.genome import constant_genome
@@ -95,7 +129,7 @@ class ProcessEvaluator(Evaluator):
         self.workers = int(workers)
         self.description = f"{self.workers} local worker processes"
         self._pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_init_worker,
-                                         initargs=(self.problems,))
+                                         initargs=(self.problems, os.getpid()))
 
     def __call__(self, genes, seeds, progress=None):
         out = np.empty((genes.shape[0], len(self.problems), len(seeds)), dtype=np.int64)
@@ -112,17 +146,45 @@ class ProcessEvaluator(Evaluator):
         self._pool.shutdown(wait=True, cancel_futures=True)
 
 
+def check_scheduler_address(address: str) -> None:
+    """Refuse a ``--scheduler`` value that is not an address, or where nothing listens.
+
+    Raises :class:`InputError` within about ``CONNECT_TIMEOUT_S`` seconds.
+    """
+    try:
+        from distributed.comm import parse_address
+        from distributed.comm.addressing import parse_host_port
+    except ImportError:
+        raise InputError("--scheduler", "Dask is not installed: pip install -e '.[dask]'") from None
+    try:
+        scheme, location = parse_address(address)
+        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
+    except (ValueError, TypeError) as exc:
+        raise InputError("--scheduler", f"{address!r} is not a scheduler address (expected "
+                         f"tcp://HOST:PORT): {exc}") from None
+    if host is None:
+        return
+    import socket
+
+    try:
+        socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
+    except OSError as exc:
+        reason = exc.strerror or str(exc) or type(exc).__name__
+        raise InputError("--scheduler", f"cannot reach a Dask scheduler at {address!r}: "
+                         f"{reason}") from None
+
+
 class DaskEvaluator(Evaluator):
     """Tasks on a Dask distributed cluster (``--scheduler ADDRESS``)."""
 
     def __init__(self, problems, bounds_mode, max_iter, address: str):
         super().__init__(problems, bounds_mode, max_iter)
+        check_scheduler_address(address)
+        from distributed import Client
+
         try:
-            from distributed import Client
-        except ImportError:
-            raise InputError("--scheduler", "Dask is not installed: pip install -e '.[dask]'") from None
-        try:
-            self._client = Client(address, timeout="10s", set_as_default=False)
+            self._client = Client(address, timeout=f"{CONNECT_TIMEOUT_S:g}s",
+                                  set_as_default=False)
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError("--scheduler", f"cannot connect to Dask scheduler {address!r}: {exc}") from None
         n = max(1, sum(self._client.nthreads().values()))

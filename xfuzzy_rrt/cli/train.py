@@ -106,8 +106,6 @@ def train(
     scenarios = load_training_scenarios(scenario)
     held_out = load_training_scenarios(validation_scenario) if validation_scenario else []
     if clearance is not None:
-        import dataclasses
-
         from xfuzzy_rrt.geometry.clearance import with_clearance
 
         scenarios = [dataclasses.replace(t, scenario=with_clearance(t.scenario, clearance))

@@ -102,9 +102,8 @@ class Problem:
 
     @classmethod
     def from_scenario(cls, scenario) -> "Problem":
-        from xfuzzy_rrt.planners.checks import check_planar_2dof
-
         from xfuzzy_rrt.geometry.clearance import planning_margin
+        from xfuzzy_rrt.planners.checks import check_planar_2dof
 
         check_planar_2dof(scenario)
         a = scenario.arrays()

@@ -16,9 +16,10 @@
 # Usage:   scripts/mutation_test.sh [WORKDIR]          (default: a new /tmp/xfuzzy-mutation.*)
 #          scripts/mutation_test.sh --weaken F [WORKDIR]
 #            instead of mutmut: make the certified check F times non-conservative in the copy
-#            (a) the motion bound divided by F, (b) the advance multiplied by F; run the safety
-#            tests (numba on) against each and print the failures. Exit 0 only when the suite
-#            fails for both, i.e. the weakening is caught. Try F = 1.05.
+#            (a) the motion bound divided by F, (b) the advance multiplied by F, (c) the user
+#            clearance held F times too leniently by edge_free, (d) by effective_margin; run
+#            the safety tests (numba on) against each and print the failures. Exit 0 only when
+#            the suite fails for every one, i.e. the weakening is caught. Try F = 1.05.
 # Env:     PYTHON (default .venv/bin/python), MUTATION_JOBS (default 1), MUTATION_TESTS,
 #          MUTATION_MUTANTS (mutant name globs, default: the safety core as above).
 # Needs:   mutmut >= 3.8 in that interpreter (.venv/bin/pip install mutmut).
@@ -61,7 +62,7 @@ fi
 cd "$WORK"
 if [ -n "$WEAKEN" ]; then
   status=0
-  for variant in bound advance; do
+  for variant in bound advance clearance effective; do
     cp "$ROOT/xfuzzy_rrt/geometry/collision.py" xfuzzy_rrt/geometry/collision.py
     "$PY" - "$variant" "$WEAKEN" <<'PYEOF'
 """Weaken the certified check in the copy: the bound M_k / F, or the advance ds * F."""
@@ -74,7 +75,14 @@ text = path.read_text()
 old, new = {
     "bound": ("        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk\n",
               f"        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk / {factor}\n"),
-    "advance": ("                step = ck / mk\n", f"                step = ck / mk * {factor}\n"),
+    "advance": ("                step = (ck - clear) / mk\n",
+                f"                step = (ck - clear) / mk * {factor}\n"),
+    # The user clearance (issue 18) held F times too leniently by the edge check ...
+    "clearance": ("    clear = margin - CERT_MARGIN_M\n",
+                  f"    clear = (margin - CERT_MARGIN_M) / {factor}\n    margin = CERT_MARGIN_M + clear if clear > 0.0 else margin\n"),
+    # ... or by the margin every planner is given for it.
+    "effective": ("    return CERT_MARGIN_M + float(clearance_m)\n",
+                  f"    return CERT_MARGIN_M + float(clearance_m) / {factor}\n"),
 }[variant]
 if text.count(old) != 1:
     sys.exit(f"error: cannot find the {variant} code to weaken in {path}")
@@ -82,7 +90,7 @@ path.write_text(text.replace(old, new))
 PYEOF
     echo "== $variant weakened by a factor $WEAKEN:"
     if PYTHONPATH="$WORK" nice -n 10 "$PY" -m pytest -q -p no:cacheprovider \
-        tests/test_safety_bounds.py tests/test_collision.py > weaken-$variant.log 2>&1; then
+        tests/test_safety_bounds.py tests/test_collision.py tests/test_margins.py > weaken-$variant.log 2>&1; then
       echo "NOT CAUGHT: the suite passes with the $variant weakened by $WEAKEN"
       status=1
     else

@@ -85,3 +85,59 @@ class Oracle:
         if bad.any():
             problems.append(f"{int(bad.sum())} colliding configurations, first {dense[bad][0]}")
         return problems
+
+    # ------------------------------------------------------------- clearance margins (issue 18)
+
+    @classmethod
+    def from_arrays(cls, links, base, radius, obstacles, limits=None) -> "Oracle":
+        """An oracle for a random arm and obstacle rows ``[kind, a, b, c, d]`` (no file)."""
+        self = cls.__new__(cls)
+        self.links = np.asarray(links, dtype=float)
+        self.base = np.asarray(base, dtype=float)
+        self.radius = float(radius)
+        n = len(self.links)
+        self.limits = (np.array([[-1e9, 1e9]] * n) if limits is None
+                       else np.asarray(limits, dtype=float))
+        self.start = self.goal = None
+        self.circles, self.boxes = [], []
+        for ob in np.asarray(obstacles, dtype=float).reshape(-1, 5):
+            if ob[0] == 0.0:
+                self.circles.append((shapely.Point(ob[1], ob[2]), float(ob[3])))
+            else:
+                self.boxes.append(shapely.box(ob[1], ob[2], ob[3], ob[4]))
+        return self
+
+    def motion_bound(self, qa, qb) -> float:
+        """Largest speed (m per unit s) of any arm point on ``qa -> qb``, re-derived here:
+        a point of link k moves at most ``Σ_{i<=k} l_i |θ̇_i|`` with ``|θ̇_i| <= Σ_{j<=i} |q̇_j|``."""
+        dq = np.abs(np.radians(np.asarray(qb, dtype=float) - np.asarray(qa, dtype=float)))
+        return float(sum(self.links[i] * dq[: i + 1].sum() for i in range(len(self.links))))
+
+    def min_distance_along(self, path_deg, resolution_deg: float = 0.02):
+        """``(sampled minimum, configuration, proven lower bound)`` of the clearance along a
+        path. The minimum is of exact distances at real configurations (so a value below a
+        margin is a real violation); the lower bound subtracts, per segment, the most any arm
+        point can move between two samples (half the sample spacing times the motion bound),
+        so nothing on the path is closer than it."""
+        path = np.atleast_2d(np.asarray(path_deg, dtype=float))
+        best, where, lower = math.inf, path[0], math.inf
+        if path.shape[0] == 1:
+            c = float(self.clearance(path)[0])
+            return c, path[0], c
+        for a, b in zip(path[:-1], path[1:]):
+            n = max(1, int(math.ceil(np.max(np.abs(b - a)) / resolution_deg)))
+            s = np.linspace(0.0, 1.0, n + 1)[:, None]
+            q = a + s * (b - a)
+            c = self.clearance(q)
+            i = int(np.argmin(c))
+            if c[i] < best:
+                best, where = float(c[i]), q[i]
+            lower = min(lower, float(c.min()) - 0.5 * self.motion_bound(a, b) / n)
+        return best, where, lower
+
+    def keeps_margin(self, path_deg, margin: float, resolution_deg: float = 0.02) -> list[str]:
+        """Violations of ``min distance >= margin`` along the path (empty: none found)."""
+        best, where, _ = self.min_distance_along(path_deg, resolution_deg)
+        if best < margin:
+            return [f"clearance {best!r} m < margin {margin!r} m at q = {where}"]
+        return []

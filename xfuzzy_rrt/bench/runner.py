@@ -146,8 +146,11 @@ def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
         if r.success:  # only a certified path: shortening keeps unchanged input edges
             from xfuzzy_rrt.planners.shortcut import shortcut_path
 
+            from xfuzzy_rrt.geometry.clearance import planning_margin
+
             short = shortcut_path(job.scenario.arrays(), r.path_deg, seed=job.seed,
-                                  attempts=SHORTCUT_ATTEMPTS)
+                                  attempts=SHORTCUT_ATTEMPTS,
+                                  margin=planning_margin(job.scenario))
             row["cost_short_deg"] = path_cost_deg(short)
     return r, row
 

@@ -67,7 +67,7 @@ def _render_summary(summary) -> str:
 
 def _run(scenarios: List[Path], planners: str, runs: int, seed: int, rulebook: Optional[Path],
          max_iter: int, out: Path, workers: int, shortcut: bool = False,
-         keep: tuple[str, ...] = ()) -> int:
+         keep: tuple[str, ...] = (), clearance: float | None = None) -> int:
     """Plan and write one bench folder, replaced as a set (``keep``: entries of an existing
     folder to carry over, e.g. the demo's scenarios). Ctrl-C: one line, the previous folder
     (or none) stays, exit 130."""
@@ -78,7 +78,9 @@ def _run(scenarios: List[Path], planners: str, runs: int, seed: int, rulebook: O
     names = check_planners([p.strip() for p in planners.split(",") if p.strip()])
     files = scenario_files(scenarios)
     check_out_dir(out, files, keep)  # fail before planning, not after
-    loaded = [load_scenario_warn(p) for p in files]
+    from xfuzzy_rrt.geometry.clearance import with_clearance
+
+    loaded = [with_clearance(load_scenario_warn(p), clearance) for p in files]
     bar = ProgressBar()
 
     def progress(done: int, total: int) -> None:
@@ -126,10 +128,12 @@ def bench(
     shortcut: bool = typer.Option(False, "--shortcut",
                                   help="Also shorten every path by certified shortcutting "
                                        "(cost_short_deg; cost_deg stays the raw cost)."),
+    clearance: Optional[float] = typer.Option(
+        None, "--clearance", help="Certified clearance in metres (default: each scenario's [safety] clearance_m, else 0)."),
 ) -> int:
     """Benchmark planners: runs.csv, summary.csv, ratios.csv and report.html in the output folder."""
     return _run(scenarios, planners, runs, seed, rulebook, max_iter, out or _default_out("bench"),
-                workers, shortcut)
+                workers, shortcut, clearance=clearance)
 
 
 def demo(

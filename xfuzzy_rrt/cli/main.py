@@ -42,6 +42,7 @@ def _register() -> None:
     __import__("xfuzzy_rrt.cli.report", fromlist=["register"]).register(app)
     train_cli.register(app)
     __import__("xfuzzy_rrt.cli.evaluate", fromlist=["register"]).register(app)
+    __import__("xfuzzy_rrt.cli.robustness", fromlist=["register"]).register(app)
     app.add_typer(rules_cli.app, name="rules")
     app.add_typer(scenarios_cli.app, name="scenarios")
 

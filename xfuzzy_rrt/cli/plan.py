@@ -29,6 +29,8 @@ def plan(
         None, "--trace", help="Write the per-iteration trace (.parquet or .csv; fuzzy-rrt)."),
     step_deg: float = typer.Option(10.0, "--step-deg", help="RRT step size in degrees."),
     goal_bias: float = typer.Option(0.05, "--goal-bias", help="RRT goal bias in [0, 1]."),
+    clearance: Optional[float] = typer.Option(
+        None, "--clearance", help="Certified clearance in metres every link keeps from every obstacle (default: the scenario's [safety] clearance_m, else 0)."),
 ) -> int:
     """Plan a path from the scenario's start to its goal.
 
@@ -57,7 +59,7 @@ def plan(
         rulebook_obj = load_rulebook(rulebook_dir)
     result = plan_scenario(
         s, planner=planner, rulebook=rulebook_obj, seed=seed, max_iter=max_iter,
-        step_deg=step_deg, goal_bias=goal_bias, trace=trace is not None,
+        step_deg=step_deg, goal_bias=goal_bias, trace=trace is not None, clearance_m=clearance,
     )
     if trace is not None:
         from xfuzzy_rrt.planners.api import write_trace

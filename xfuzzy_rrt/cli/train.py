@@ -85,6 +85,7 @@ def train(
     seed_rulebook: Optional[List[Path]] = typer.Option(None, "--seed-rulebook", help="Rulebook directory the seeded first generation starts from (repeatable; default: the shipped expert when its bounds mode matches --bounds). Its SHA-256 is recorded."),
     validation_runs: int = typer.Option(50, "--validation-runs", help="Runs per scenario to choose the final rulebook."),
     name: Optional[str] = typer.Option(None, "--name", help="Rulebook name (default: the --out folder's name)."),
+    clearance: Optional[float] = typer.Option(None, "--clearance", help="Certified clearance in metres the planner must keep while training (default: each scenario's, else 0)."),
 ) -> int:
     """Train the six fuzzy systems with the paper's genetic algorithm; write a rulebook."""
     import dataclasses
@@ -104,6 +105,13 @@ def train(
 
     scenarios = load_training_scenarios(scenario)
     held_out = load_training_scenarios(validation_scenario) if validation_scenario else []
+    if clearance is not None:
+        from xfuzzy_rrt.geometry.clearance import with_clearance
+
+        scenarios = [dataclasses.replace(t, scenario=with_clearance(t.scenario, clearance))
+                     for t in scenarios]
+        held_out = [dataclasses.replace(t, scenario=with_clearance(t.scenario, clearance))
+                    for t in held_out]
     if target_fitness is None:
         target_fitness = 9750.0 if fitness == "paper" else 1e9
     base = v_base = ()

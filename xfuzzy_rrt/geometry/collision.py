@@ -18,6 +18,21 @@ fails as soon as the clearance drops to ``margin`` or below and succeeds when ``
 The margin (default 1e-6 m = 1 µm) absorbs floating-point error and guarantees termination:
 every step is at least ``margin / max_k M_k`` long. Nodes are held to the same margin so that
 every edge leaving an accepted node can be certified.
+
+**A surgeon's clearance (certified).** A user clearance ``c`` (metres; ``[safety] clearance_m``
+or ``--clearance``) enters the kernels folded into the one ``margin`` they already carry:
+``margin = effective_margin(c) = CERT_MARGIN_M + c``. ``edge_free`` recovers the clearance as
+``clear = margin - CERT_MARGIN_M`` and treats ``c_k - clear`` as the free distance: it steps by
+``min_k (c_k - clear) / M_k`` and fails when a stop has ``c_k <= margin`` (i.e. ``c_k - clear``
+at most the 1 µm termination slack). Why this holds the clearance *everywhere* on the segment,
+not only at the stops: between two stops ``s`` and ``s + ds`` link *k* keeps at least
+``max(c_k(s) - M_k t, c_k(s + ds) - M_k (ds - t))`` at ``s + t``, and with
+``M_k ds <= c_k(s) - clear`` and ``c_k(s + ds) > margin`` that is more than
+``(clear + margin) / 2 = c + 0.5 µm``. So every point of every link capsule keeps at least ``c``
+from every obstacle along every certified segment. With ``c = 0`` (the default), ``clear`` is
+exactly ``0.0`` and ``c_k - 0.0 == c_k`` in floating point: the arithmetic, hence every plan, is
+bit-for-bit the one without a clearance (tests/test_golden.py). Margins below ``CERT_MARGIN_M``
+(tests use them) are treated as a clearance of 0.
 """
 
 from __future__ import annotations
@@ -27,8 +42,12 @@ import math
 import numba as nb
 import numpy as np
 
+from xfuzzy_rrt.errors import InputError
+
 #: Minimum clearance (metres) a configuration must keep to count as free for the planners.
 CERT_MARGIN_M = 1e-6
+#: Largest user clearance accepted (metres): beyond 1 m no arm in scope has any free space.
+MAX_CLEARANCE_M = 1.0
 
 _TWO_PI = 2.0 * math.pi
 
@@ -186,13 +205,18 @@ def link_motion_bound(links, qa_deg, qb_deg, k):
 def edge_free(links, base, radius, obstacles, qa_deg, qb_deg, margin):
     """Certified check of the straight joint segment ``qa -> qb`` (conservative advancement).
 
-    Returns True only if every configuration on the segment keeps clearance > 0 (and the
-    sampled stops keep clearance > ``margin``). Both endpoints must be within the joint limits
-    already (the box is convex, so the whole segment then is). See the module docstring.
+    Returns True only if every configuration on the segment keeps clearance >=
+    ``margin - CERT_MARGIN_M`` (the user clearance; > 0 when that is 0) and the sampled stops
+    keep clearance > ``margin``. Both endpoints must be within the joint limits already (the
+    box is convex, so the whole segment then is). See the module docstring.
     """
     n = links.shape[0]
     if obstacles.shape[0] == 0:
         return True
+    # The user clearance folded into ``margin`` (exactly 0.0 for the default margin).
+    clear = margin - CERT_MARGIN_M
+    if not clear > 0.0:
+        clear = 0.0
     s = 0.0
     while True:
         # Per-link clearance at q(s) and the safe advance it buys.
@@ -219,7 +243,7 @@ def edge_free(links, base, radius, obstacles, qa_deg, qb_deg, margin):
                 cmin = ck
             mk = link_motion_bound(links, qa_deg, qb_deg, k)
             if mk > 0.0:
-                step = ck / mk
+                step = (ck - clear) / mk
                 if step < ds:
                     ds = step
         if cmin <= margin:
@@ -299,6 +323,30 @@ def in_collision(arrays, q_deg) -> bool:
     if not within_limits(arrays.limits_deg, q):
         return True
     return clearance(arrays, q) <= 0.0
+
+
+def effective_margin(clearance_m: float = 0.0) -> float:
+    """The ``margin`` every kernel takes for a user clearance of ``clearance_m`` metres.
+
+    ``CERT_MARGIN_M + clearance_m``: configurations must keep more than that, and
+    :func:`edge_free` certifies at least ``clearance_m`` along every segment (module
+    docstring). ``effective_margin(0.0) == CERT_MARGIN_M`` exactly, so the default changes
+    nothing. Raises :class:`~xfuzzy_rrt.errors.InputError` (``--clearance``) for a negative,
+    non-finite or absurd value.
+    """
+    check_clearance(clearance_m)
+    return CERT_MARGIN_M + float(clearance_m)
+
+
+def check_clearance(clearance_m, where: str = "--clearance") -> float:
+    """``clearance_m`` as a float in ``[0, MAX_CLEARANCE_M]`` or one InputError naming ``where``."""
+    if isinstance(clearance_m, bool) or not isinstance(clearance_m, (int, float, np.floating)):
+        raise InputError(where, f"must be a number of metres, got {clearance_m!r}")
+    c = float(clearance_m)
+    if not (math.isfinite(c) and 0.0 <= c <= MAX_CLEARANCE_M):
+        raise InputError(where, f"must be a clearance in metres within [0, {MAX_CLEARANCE_M:g}], "
+                         f"got {clearance_m!r}")
+    return c
 
 
 def segment_free(arrays, qa_deg, qb_deg, margin: float = CERT_MARGIN_M) -> bool:

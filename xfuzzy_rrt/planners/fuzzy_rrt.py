@@ -46,8 +46,8 @@ import numpy as np
 
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_OUTPUTS
+from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.collision import (
-    CERT_MARGIN_M,
     direction_and_distance,
     nearest_obstacle_from_point,
 )
@@ -243,14 +243,16 @@ def _resolve_rulebook(rulebook):
 
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,
                    trace: bool = False, min_step_deg: float = MIN_STEP_DEG,
-                   margin: float = CERT_MARGIN_M) -> PlanResult:
+                   margin: float | None = None, clearance_m: float | None = None) -> PlanResult:
     """Plan with Fuzzy-RRT.
 
     ``rulebook`` is a loaded :class:`~xfuzzy_rrt.fuzzy.rulebook.Rulebook`, a rulebook directory,
     or ``None`` for the shipped default. With ``trace=True`` the result carries a per-iteration
     DataFrame (see :mod:`xfuzzy_rrt.planners.trace`). Same inputs and seed, same result.
+    ``clearance_m``/``margin`` as for :func:`~xfuzzy_rrt.planners.rrt.plan_rrt`.
     """
     check_planar_2dof(scenario)
+    margin = planning_margin(scenario, clearance_m, margin)
     check_max_iter(max_iter)
     rb = _resolve_rulebook(rulebook)
     knots, consts = rb.compiled

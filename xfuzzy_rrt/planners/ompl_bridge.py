@@ -197,9 +197,10 @@ def make_validity_callback(arrays, margin: float = CERT_MARGIN_M):
 # ----------------------------------------------------------------------------------------------
 
 def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 10_000,
-              step_deg: float = 10.0, goal_bias: float = 0.05, margin: float = CERT_MARGIN_M,
+              step_deg: float = 10.0, goal_bias: float = 0.05, margin: float | None = None,
               time_limit_s: float | None = None,
-              validity_resolution: float | None = None) -> PlanResult:
+              validity_resolution: float | None = None,
+              clearance_m: float | None = None) -> PlanResult:
     """Plan ``scenario`` with OMPL planner ``planner`` (``"RRT"`` or ``"ompl:RRT"``).
 
     ``validity_resolution`` is OMPL's state-validity checking resolution as a fraction of the
@@ -213,6 +214,9 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
     check_positive("step_deg", step_deg)
     if not 0.0 <= goal_bias <= 1.0:
         raise InputError("goal_bias", f"must lie in [0, 1], got {goal_bias!r}")
+    from xfuzzy_rrt.geometry.clearance import planning_margin  # validity callback and certify
+
+    margin = planning_margin(scenario, clearance_m, margin)
     if time_limit_s is None:
         time_limit_s = max(10.0, 1e-3 * max_iter)
     check_positive("time_limit_s", time_limit_s)

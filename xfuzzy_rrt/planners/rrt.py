@@ -17,7 +17,7 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
+from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_max_iter, check_planar_2dof, check_positive
 from xfuzzy_rrt.planners.extend import extend
@@ -56,9 +56,14 @@ def rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, max_it
 
 def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER,
              step_deg: float = DEFAULT_STEP_DEG, goal_bias: float = DEFAULT_GOAL_BIAS,
-             margin: float = CERT_MARGIN_M) -> PlanResult:
-    """Plan with RRT. Same inputs and seed give the same result (``wall_s`` aside)."""
+             margin: float | None = None, clearance_m: float | None = None) -> PlanResult:
+    """Plan with RRT. Same inputs and seed give the same result (``wall_s`` aside).
+
+    ``clearance_m``: the certified clearance (m; default the scenario's ``clearance_m``, else
+    0); ``margin``: an explicit kernel margin instead (see ``geometry/clearance.py``).
+    """
     check_planar_2dof(scenario)
+    margin = planning_margin(scenario, clearance_m, margin)
     check_positive("step_deg", step_deg)
     if not 0.0 <= goal_bias <= 1.0:
         raise InputError("goal_bias", f"must lie in [0, 1], got {goal_bias!r}")

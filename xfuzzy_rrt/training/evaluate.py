@@ -97,15 +97,19 @@ class Problem:
     limits: np.ndarray
     start: np.ndarray
     goal: np.ndarray
+    #: The kernels' margin: the scenario's clearance folded in (geometry/clearance.py).
+    margin: float = CERT_MARGIN_M
 
     @classmethod
     def from_scenario(cls, scenario) -> "Problem":
+        from xfuzzy_rrt.geometry.clearance import planning_margin
         from xfuzzy_rrt.planners.checks import check_planar_2dof
 
         check_planar_2dof(scenario)
         a = scenario.arrays()
         return cls(name=scenario.name, links=a.links, base=a.base, radius=float(a.link_radius),
-                   obstacles=a.obstacles, limits=a.limits_deg, start=a.start_deg, goal=a.goal_deg)
+                   obstacles=a.obstacles, limits=a.limits_deg, start=a.start_deg, goal=a.goal_deg,
+                   margin=planning_margin(scenario))
 
 
 def iterations_for(problems: list[Problem], knots_b: np.ndarray, consts_b: np.ndarray,
@@ -124,7 +128,7 @@ def iterations_for(problems: list[Problem], knots_b: np.ndarray, consts_b: np.nd
         tree = Tree(int(max_iter) + 2, pr.limits)
         out[:, s, :] = run_population(
             pr.links, pr.base, pr.radius, pr.obstacles, pr.limits, pr.start, pr.goal,
-            knots_b, consts_b, mode, seeds, int(max_iter), MIN_STEP_DEG, CERT_MARGIN_M,
+            knots_b, consts_b, mode, seeds, int(max_iter), MIN_STEP_DEG, pr.margin,
             tree.nodes, tree.parent, tree.cell_next, tree.cell_head, tree.meta, tree.grid)
     return out
 
@@ -189,7 +193,7 @@ def rrt_baseline(problems: list[Problem], seeds: np.ndarray, max_iter: int) -> n
             tree.cell_head[:] = -1
             ok, x, _ = rrt_kernel(pr.links, pr.base, pr.radius, pr.obstacles, pr.limits,
                                   pr.start, pr.goal, int(seed), int(max_iter), DEFAULT_STEP_DEG,
-                                  DEFAULT_GOAL_BIAS, CERT_MARGIN_M, tree.nodes, tree.parent,
+                                  DEFAULT_GOAL_BIAS, pr.margin, tree.nodes, tree.parent,
                                   tree.cell_next, tree.cell_head, tree.meta, tree.grid)
             its.append(x if ok else max_iter)
         out[s] = float(np.median(its))

@@ -1,0 +1,304 @@
+"""The user's clearance margin: where it comes from, what it forbids, and how much a path keeps.
+
+A surgeon states a clearance (metres): every point of every link capsule must keep at least
+that much from every obstacle along the whole motion. It comes from ``--clearance`` when given,
+else from the scenario's ``[safety] clearance_m``, else 0 (:func:`resolve_clearance`). The
+planners turn it into the one ``margin`` their kernels carry
+(:func:`~xfuzzy_rrt.geometry.collision.effective_margin`), which the certified edge check then
+holds *between* its stops as well (see ``collision.py``). A start or goal already closer than
+the clearance makes the problem unsolvable by definition, so it is refused up front with one
+line naming where the clearance came from (:func:`planning_margin`).
+
+:func:`path_min_clearance` measures what a path actually keeps: the exact smallest signed
+distance between any link capsule and any obstacle over *every* configuration of the path (not
+only its vertices), where it occurs, and a proven lower bound. It is a Lipschitz branch and
+bound on each segment built on the same motion bound as the certified check: along
+``q(s) = qa + s (qb - qa)`` no point of the arm moves faster than ``M = max_k M_k`` per unit
+``s``, and a signed distance to a convex obstacle changes no faster than the points do, so on
+``[s0, s1]`` with end values ``c0, c1`` nothing is below ``(c0 + c1 - M (s1 - s0)) / 2`` --
+the two-sided form of conservative advancement. Intervals that cannot beat the best value seen
+by more than ``tol`` are dropped, the others halved.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+
+from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.geometry.collision import (
+    CERT_MARGIN_M,
+    check_clearance,
+    clearance_kernel,
+    effective_margin,
+    link_motion_bound,
+)
+from xfuzzy_rrt.geometry.path_check import signed_segment_obstacle_dist
+
+#: The exact minimum clearance along a path is bracketed to within this (metres).
+MIN_CLEARANCE_TOL_M = 1e-9
+#: Distance evaluations per path after which the search reports its proven lower bound.
+MIN_CLEARANCE_MAX_EVALS = 2_000_000
+
+
+def resolve_clearance(scenario, clearance_m: float | None = None) -> float:
+    """The clearance in force: ``clearance_m`` when given (``--clearance``), else the scenario's
+    ``[safety] clearance_m`` (read with ``getattr`` so older scenario objects mean 0), else 0."""
+    if clearance_m is not None:
+        return check_clearance(clearance_m, "--clearance")
+    own = getattr(scenario, "clearance_m", 0.0)
+    where = f"{getattr(scenario, 'source', '') or getattr(scenario, 'name', 'scenario')}: safety.clearance_m"
+    return check_clearance(own if own is not None else 0.0, where)
+
+
+def with_clearance(scenario, clearance_m: float | None):
+    """``scenario`` with its clearance set to ``clearance_m`` (``None``: unchanged).
+
+    How ``--clearance`` reaches code that only sees scenarios (the bench runner, training):
+    every planner then resolves it from the scenario. Validated here (``--clearance``).
+    """
+    import dataclasses
+
+    if clearance_m is None:
+        return scenario
+    c = check_clearance(clearance_m, "--clearance")
+    if any(f.name == "clearance_m" for f in dataclasses.fields(scenario)):
+        return dataclasses.replace(scenario, clearance_m=c)
+    copy = dataclasses.replace(scenario)  # a Scenario without the field (older model)
+    object.__setattr__(copy, "clearance_m", c)
+    return copy
+
+
+def planning_margin(scenario, clearance_m: float | None = None,
+                    margin: float | None = None) -> float:
+    """The kernels' ``margin`` for planning ``scenario`` with the clearance in force.
+
+    ``margin`` (an explicit kernel margin, as tests and older callers pass) wins when given and
+    no clearance is asked for. Otherwise the clearance is resolved (:func:`resolve_clearance`)
+    and the start and goal must keep more than it: an InputError names ``--clearance`` or the
+    scenario file, whichever set the clearance. With no clearance anywhere the result is exactly
+    ``CERT_MARGIN_M``, today's margin.
+    """
+    if margin is not None and clearance_m is None:
+        return float(margin)
+    c = resolve_clearance(scenario, clearance_m)
+    m = effective_margin(c)
+    if c > 0.0:
+        check_endpoints_keep(scenario, c, m, "--clearance" if clearance_m is not None else
+                             f"{scenario.source or scenario.name}: safety.clearance_m")
+    return m
+
+
+def check_endpoints_keep(scenario, clearance_m: float, margin: float, where: str) -> None:
+    """Raise one InputError when the start or the goal is within ``margin`` of an obstacle."""
+    a = scenario.arrays()
+    for label, q in (("start", a.start_deg), ("goal", a.goal_deg)):
+        c = float(clearance_kernel(a.links, a.base, a.link_radius, a.obstacles, q))
+        if not c > margin:
+            raise InputError(where, f"the {label} configuration is {_mm(c)} from an obstacle, "
+                             f"closer than the clearance {_mm(clearance_m)}: no path can keep it")
+
+
+def _mm(x: float) -> str:
+    return f"{x * 1e3:.4g} mm"
+
+
+@dataclass(frozen=True)
+class MinClearance:
+    """The smallest signed clearance of a path (negative: penetration depth) and where."""
+
+    #: Exact signed distance (m) at ``config_deg``; ``inf`` without obstacles, ``nan`` for an
+    #: empty path.
+    value_m: float
+    #: Segment ``path[i] -> path[i + 1]`` it lies on (0 for a one-point path; -1 for none).
+    segment: int
+    #: Position on that segment, in [0, 1].
+    s: float
+    #: The configuration (degrees) where it occurs.
+    config_deg: tuple[float, ...]
+    #: No configuration on the path is closer than this (``value_m - tol`` unless the
+    #: evaluation budget ran out).
+    lower_bound_m: float
+
+
+@nb.njit(cache=True, nogil=True)
+def link_clearances(links, base, radius, obstacles, q_deg, out):
+    """Signed clearance of each link capsule (``out[k]``) to its nearest obstacle; the min."""
+    best = np.inf
+    x = base[0]
+    y = base[1]
+    theta = 0.0
+    for k in range(links.shape[0]):
+        theta += math.radians(q_deg[k])
+        nx = x + links[k] * math.cos(theta)
+        ny = y + links[k] * math.sin(theta)
+        ck = np.inf
+        for o in range(obstacles.shape[0]):
+            d = signed_segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - radius
+            if d < ck:
+                ck = d
+        out[k] = ck
+        if ck < best:
+            best = ck
+        x = nx
+        y = ny
+    return best
+
+
+@nb.njit(cache=True, nogil=True)
+def _interval_bound(c0, c1, mk, width):
+    """Nothing on the interval is below this: min over links of ``(c0_k + c1_k - M_k w) / 2``."""
+    lb = np.inf
+    for k in range(c0.shape[0]):
+        v = 0.5 * (c0[k] + c1[k] - mk[k] * width)
+        if v < lb:
+            lb = v
+    return lb
+
+
+@nb.njit(cache=True, nogil=True)
+def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals, decide_contact):
+    """``(value, segment, s, lower bound)`` of the signed clearance along ``path`` (degrees).
+
+    With ``decide_contact`` an interval is also refined while it might hold a contact the
+    best value does not show yet (``lb <= 0 < best``), so that ``value <= 0`` (touching) is
+    decided exactly even with a coarse ``tol`` (the Monte Carlo's 1 µm): near a smooth
+    minimum the work grows like ``1 / sqrt(tol)``, and only the trials that come within
+    ``tol`` of touching pay for the sign.
+
+    Branch and bound per segment with one Lipschitz constant per link (``M_k``: inner links
+    move less, so a link that is far from everything stops costing evaluations early);
+    segments are visited in the order of their initial bound, so the best value is tight
+    early and prunes the rest.
+    """
+    n = path.shape[0]
+    nl = links.shape[0]
+    if obstacles.shape[0] == 0 or n == 0:
+        return np.inf, -1, 0.0, np.inf
+    cv = np.empty((n, nl))
+    best = np.inf
+    best_seg = 0
+    best_s = 0.0
+    for i in range(n):
+        c = link_clearances(links, base, radius, obstacles, path[i], cv[i])
+        if c < best:
+            best = c
+            if i < n - 1 or n == 1:
+                best_seg = i
+                best_s = 0.0
+            else:
+                best_seg = n - 2
+                best_s = 1.0
+    if n == 1:
+        return best, best_seg, best_s, best
+    mks = np.empty((n - 1, nl))
+    first = np.empty(n - 1)
+    for i in range(n - 1):
+        for k in range(nl):
+            mks[i, k] = link_motion_bound(links, path[i], path[i + 1], k)
+        first[i] = _interval_bound(cv[i], cv[i + 1], mks[i], 1.0)
+    order = np.argsort(first)
+    floor = np.inf
+    evals = n
+    cap = 256
+    s0s = np.empty(cap)
+    s1s = np.empty(cap)
+    c0s = np.empty((cap, nl))
+    c1s = np.empty((cap, nl))
+    cm = np.empty(nl)
+    c1_old = np.empty(nl)
+    q = np.empty(path.shape[1])
+    for oi in range(n - 1):
+        i = order[oi]
+        if first[i] >= best - tol and (first[i] > 0.0 or best <= 0.0 or not decide_contact):
+            break  # sorted: no later segment can do better either
+        qa = path[i]
+        qb = path[i + 1]
+        mk = mks[i]
+        s0s[0] = 0.0
+        s1s[0] = 1.0
+        c0s[0, :] = cv[i]
+        c1s[0, :] = cv[i + 1]
+        top = 1
+        while top > 0:
+            top -= 1
+            s0 = s0s[top]
+            s1 = s1s[top]
+            lb = _interval_bound(c0s[top], c1s[top], mk, s1 - s0)
+            if lb >= best - tol and (lb > 0.0 or best <= 0.0 or not decide_contact):
+                continue
+            sm = 0.5 * (s0 + s1)
+            if evals >= max_evals or top + 2 > cap or not (s0 < sm < s1):
+                if lb < floor:
+                    floor = lb
+                continue
+            for d in range(q.shape[0]):
+                q[d] = qa[d] + sm * (qb[d] - qa[d])
+            c = link_clearances(links, base, radius, obstacles, q, cm)
+            evals += 1
+            if c < best:
+                best = c
+                best_seg = i
+                best_s = sm
+            # Both halves go on the stack; the one with the smaller bound is explored first.
+            for k in range(nl):
+                c1_old[k] = c1s[top, k]
+            left = _interval_bound(c0s[top], cm, mk, sm - s0)
+            right = _interval_bound(cm, c1_old, mk, s1 - sm)
+            if left <= right:
+                # push right then left (left on top)
+                s0s[top + 1] = s0
+                s1s[top + 1] = sm
+                c0s[top + 1, :] = c0s[top]
+                c1s[top + 1, :] = cm
+                s0s[top] = sm
+                s1s[top] = s1
+                c0s[top, :] = cm
+                c1s[top, :] = c1_old
+            else:
+                s0s[top + 1] = sm
+                s1s[top + 1] = s1
+                c0s[top + 1, :] = cm
+                c1s[top + 1, :] = c1_old
+                s1s[top] = sm
+                c1s[top, :] = cm
+            top += 2
+    return best, best_seg, best_s, min(best - tol, floor)
+
+
+def path_min_clearance(arrays, path_deg, tol: float = MIN_CLEARANCE_TOL_M,
+                       max_evals: int = MIN_CLEARANCE_MAX_EVALS) -> MinClearance:
+    """Exact smallest signed clearance over every configuration of ``path_deg`` ([n, dof]
+    degrees) in ``arrays`` (a ``ScenarioArrays``), where it occurs and a proven lower bound.
+
+    ``value_m`` is a real distance at a real configuration on the path; nothing on the path is
+    closer than ``lower_bound_m`` (``value_m - tol`` unless ``max_evals`` ran out).
+    """
+    path = np.ascontiguousarray(np.asarray(path_deg, dtype=np.float64))
+    dof = arrays.links.shape[0]
+    if path.size == 0:
+        return MinClearance(math.nan, -1, 0.0, (), math.nan)
+    if path.ndim != 2 or path.shape[1] != dof:
+        raise InputError("path", f"must be an array of shape [n, {dof}], got {path.shape}")
+    if not np.all(np.isfinite(path)):
+        raise InputError("path", "contains non-finite angles")
+    if not (tol > 0.0 and math.isfinite(tol)):
+        raise InputError("tol", f"must be a positive number of metres, got {tol!r}")
+    value, seg, s, lower = min_clearance_kernel(arrays.links, arrays.base, arrays.link_radius,
+                                                arrays.obstacles, path, float(tol),
+                                                int(max_evals), False)
+    seg = int(seg)
+    where: tuple[float, ...] = ()
+    if seg >= 0:
+        qa = path[seg]
+        qb = path[min(seg + 1, path.shape[0] - 1)]
+        where = tuple(float(v) for v in qa + s * (qb - qa))
+    return MinClearance(float(value), seg, float(s), where, float(lower))
+
+
+__all__ = ["CERT_MARGIN_M", "MIN_CLEARANCE_TOL_M", "MinClearance", "check_endpoints_keep",
+           "min_clearance_kernel", "path_min_clearance", "planning_margin", "resolve_clearance",
+           "with_clearance"]

@@ -536,3 +536,14 @@ def test_a_checkpoint_with_an_unknown_array_or_meta_key_is_refused(tmp_path):
         load_checkpoint(tmp_path, config)
     assert str(info.value) == (f"{path}: unknown key 'generations' in meta "
                                f"(did you mean 'generation'?)")
+
+
+def test_a_training_clearance_is_recorded_and_a_resume_with_another_is_refused(tmp_path):
+    proc = _train(tmp_path, "--clearance", "0.002", "--generations", "2", "--workers", "1")
+    assert proc.returncode == 0, proc.stderr
+    manifest = (tmp_path / "rb" / "rulebook.toml").read_text()
+    assert "--clearance 0.002" in manifest and "clearance_m = 0.002" in manifest
+    other = _train(tmp_path, "--clearance", "0.003", "--generations", "3", "--workers", "1",
+                   "--resume")
+    assert other.returncode == 2, other.stderr
+    assert other.stderr.startswith("error: ") and len(other.stderr.strip().splitlines()) == 1

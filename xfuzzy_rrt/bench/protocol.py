@@ -45,10 +45,11 @@ class ProtocolResult:
     summary: pd.DataFrame  # SUMMARY_COLUMNS
 
 
-def _one(scenario, planner: str, rulebook, seed: int, max_iter: int) -> dict:
+def _one(scenario, planner: str, rulebook, seed: int, max_iter: int, clearance_m) -> dict:
     from xfuzzy_rrt.planners.api import plan_scenario
 
-    r = plan_scenario(scenario, planner=planner, rulebook=rulebook, seed=seed, max_iter=max_iter)
+    r = plan_scenario(scenario, planner=planner, rulebook=rulebook, seed=seed, max_iter=max_iter,
+                      clearance_m=clearance_m)
     ok = bool(getattr(r, "success", False))
     return {"success": ok, "iterations": int(r.iterations) if ok else int(max_iter),
             "cost_deg": float(r.cost_deg) if ok and r.cost_deg is not None else np.nan,
@@ -56,8 +57,11 @@ def _one(scenario, planner: str, rulebook, seed: int, max_iter: int) -> dict:
 
 
 def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs: int = 50,
-                 seed: int = 0, max_iter: int = 10_000, progress=None) -> ProtocolResult:
+                 seed: int = 0, max_iter: int = 10_000, progress=None,
+                 clearance_m: float | None = None) -> ProtocolResult:
     """Run RRT and every ``(label, planner, rulebook)`` of *planners* on every scenario.
+
+    ``clearance_m`` is the certified margin every planner must keep (``None``: each scenario's).
 
     ``planner`` is a name :func:`~xfuzzy_rrt.planners.api.plan_scenario` takes (``fuzzy-rrt``
     with a loaded ``rulebook``, or ``ompl:NAME``); ``label`` names it in the tables.
@@ -70,7 +74,7 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
         for label, planner, rb in entries:
             for k in range(runs):
                 rows.append({"scenario": sc.name, "planner": label, "seed": seed + k,
-                             **_one(sc, planner, rb, seed + k, max_iter)})
+                             **_one(sc, planner, rb, seed + k, max_iter, clearance_m)})
             done += 1
             if progress:
                 progress(done, total)

@@ -36,6 +36,7 @@ def evaluate(
     seed: int = typer.Option(0, "--seed", help="First seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run; a failure counts as this many iterations."),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for runs.csv, problems.csv and summary.csv."),
+    clearance: Optional[float] = typer.Option(None, "--clearance", help="Certified clearance in metres every planner must keep (default: each scenario's [safety] clearance_m, else 0)."),
 ) -> int:
     """Evaluate rulebooks against RRT on a folder of problems: per-problem median iteration
     ratios summarised as median / geometric mean / worst, success, cost and time ratios."""
@@ -49,6 +50,10 @@ def evaluate(
     if not 1 <= runs <= 100_000:
         raise InputError("--runs", f"must lie in [1, 100000], got {runs}")
     check_max_iter(max_iter)
+    if clearance is not None:
+        from xfuzzy_rrt.geometry.collision import check_clearance
+
+        check_clearance(clearance)
     if out is not None and out.exists() and not out.is_dir():
         raise InputError(str(out), "exists and is not a directory")
     entries = []
@@ -71,7 +76,7 @@ def evaluate(
             sys.stderr.flush()
 
     result = run_protocol(scenarios, entries, runs=runs, seed=seed, max_iter=max_iter,
-                          progress=progress)
+                          progress=progress, clearance_m=clearance)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     if out is not None:

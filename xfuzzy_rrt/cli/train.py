@@ -129,6 +129,7 @@ def train(
         scenarios=tuple((t.scenario.name, t.sha256) for t in scenarios),
         fitness=fitness, baseline=base,
         validation=tuple((t.scenario.name, t.sha256) for t in held_out), validation_baseline=v_base,
+        clearance_m=clearance,
     )
     seeds = resolve_seed_rulebooks(seed_rulebook, config.init, config.bounds)
     config = dataclasses.replace(config, seed_rulebooks=tuple((s.rulebook.name, s.sha256)

@@ -86,6 +86,10 @@ class GAConfig:
     baseline: tuple[float, ...] = ()  # RRT median iterations per training scenario (log-ratio)
     validation: tuple[tuple[str, str], ...] = ()  # held-out scenarios that pick the final rulebook
     validation_baseline: tuple[float, ...] = ()
+    #: ``--clearance``: the certified margin (m) every training run must keep; ``None``: each
+    #: scenario's own ``[safety] clearance_m``. A run that cannot keep it fails (reward as for
+    #: any failure), so a rulebook can be trained for a margin.
+    clearance_m: float | None = None
     #: (name, sha256) of each seed rulebook of a seeded first generation, in order: the first
     #: generation depends on them, so they are part of the fingerprint and of the provenance.
     seed_rulebooks: tuple[tuple[str, str], ...] = ()
@@ -128,7 +132,7 @@ class GAConfig:
     #: Options added after the first checkpoints were written: left out of the fingerprint
     #: while they keep their default, so older checkpoints still resume.
     LATER = {"fitness": "paper", "baseline": (), "validation": (), "validation_baseline": (),
-             "seed_rulebooks": ()}
+             "seed_rulebooks": (), "clearance_m": None}
 
     def fingerprint(self) -> str:
         """SHA-256 of the options that shape the search (identifies a checkpoint's run),

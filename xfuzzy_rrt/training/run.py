@@ -168,7 +168,7 @@ def canonical_command(config: GAConfig, scenario_args: list[str], out: str,
                ("mutation_rate", "--mutation-rate"), ("mutation_eta", "--mutation-eta"),
                ("block_rate", "--block-rate"), ("block_sigma", "--block-sigma"),
                ("init", "--init"), ("validation_runs", "--validation-runs"),
-               ("fitness", "--fitness")]
+               ("fitness", "--fitness"), ("clearance_m", "--clearance")]
     always = {"population", "generations", "runs_per_eval", "target_fitness", "seed", "bounds"}
     for attr, flag in options:
         value = getattr(config, attr)
@@ -343,6 +343,7 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
         "validation_success_rate": result.validation_success_rate,
         "history": HISTORY_FILE,
         "fitness": c.fitness,
+        **({"clearance_m": c.clearance_m} if c.clearance_m is not None else {}),
         "scenarios": [{"name": t.scenario.name, "file": t.path, "sha256": t.sha256}
                       for t in job.scenarios],
         "seed_rulebooks": [{"name": s.rulebook.name, "source": s.source, "sha256": s.sha256}

@@ -299,3 +299,17 @@ def test_rule_analysis_tools_work_on_goal_frame_rulebooks(tmp_path, run_cli):
     assert proc.returncode == 0 and "uniform_share" in proc.stdout
     proc = run_cli("rules", "show", tmp_path / "gf", "--when", "dist_to_goal=near")
     assert proc.returncode == 2 and "unknown input 'dist_to_goal'" in proc.stderr
+
+
+def test_protocol_with_a_clearance_skips_problems_whose_ends_cannot_keep_it(tmp_path, run_cli):
+    proc = run_cli("evaluate", *SCENARIOS, "--rulebook", "goal-frame", "--runs", "2",
+                   "--clearance", "0.5")
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines()[-1] == (
+        "error: --clearance: no problem's start and goal keep this clearance")
+    assert "note: skipped two-circles" in proc.stderr
+    ok = run_cli("evaluate", *SCENARIOS, "--rulebook", "goal-frame", "--runs", "2",
+                 "--clearance", "0.002", "--out", tmp_path / "o")
+    assert ok.returncode == 0, ok.stderr
+    runs = pd.read_csv(tmp_path / "o" / "runs.csv")
+    assert runs["success"].all()

@@ -66,6 +66,21 @@ def evaluate(
     if len(set(labels)) != len(labels):
         raise InputError("--rulebook", "two planners share a name; give each rulebook once")
     scenarios = [load_scenario(f) for f in scenario_files(problems)]
+    if clearance is not None:
+        # a batch protocol reports problems that no path can solve at this margin (start or
+        # goal inside it) and goes on with the others; plan and bench refuse them outright
+        from xfuzzy_rrt.geometry.clearance import planning_margin
+
+        kept = []
+        for sc in scenarios:
+            try:
+                planning_margin(sc, clearance)
+                kept.append(sc)
+            except InputError as exc:
+                typer.echo(f"note: skipped {sc.name}: {exc}", err=True)
+        if not kept:
+            raise InputError("--clearance", "no problem's start and goal keep this clearance")
+        scenarios = kept
     names = [s.name for s in scenarios]
     if len(set(names)) != len(names):
         raise InputError("PROBLEMS", "two problems share a scenario name")

@@ -129,7 +129,8 @@ def test_the_installed_wheel_plans_benchmarks_demos_and_trains_from_anywhere(ins
     assert demo.returncode == 0, demo.stderr
     paper = json.loads((work / "d" / "paper-reference" / "bench.json").read_text())
     assert [s["name"] for s in paper["scenarios"]] == ["paper-reference"]
-    assert paper["rulebook"]["name"] == "paper"
+    # the paper's setting: the paper rulebook beside the default, on the packaged reference
+    assert {r["name"] for r in paper["rulebooks"]} == {"paper", "goal-frame"}
     assert paper["git"] == {"commit": None, "dirty": None}  # not a checkout: no foreign commit
 
     train = run("train", "--scenario", "problem.toml", "--init", "seeded", "--population", "10",

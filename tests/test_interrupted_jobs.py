@@ -18,7 +18,6 @@ import os
 import shutil
 import signal
 import subprocess
-import time
 from pathlib import Path
 
 import pandas as pd
@@ -38,32 +37,6 @@ def temp_files(folder: Path) -> list[Path]:
     if not folder.is_dir():
         return []
     return [p for p in folder.rglob(".*") if p.is_file() and p.name.endswith(".tmp")]
-
-
-def run_interrupted(args: list[str], sig: int, trigger, logs: Path) -> tuple[int, str, bool]:
-    """Start ``xfuzzy-rrt ARGS``; send ``sig`` as soon as ``trigger(stderr_text)`` is true.
-
-    Returns ``(exit code, stderr, interrupted)``; ``interrupted`` is False when the job
-    finished before the trigger fired.
-    """
-    logs.mkdir(parents=True, exist_ok=True)
-    err_path = logs / "stderr.txt"
-    with open(logs / "stdout.txt", "w") as out, open(err_path, "w") as err:
-        proc = subprocess.Popen([console_script(), *map(str, args)], stdout=out, stderr=err)
-        sent = False
-        t0 = time.monotonic()
-        while proc.poll() is None and time.monotonic() - t0 < TIMEOUT_S:
-            if trigger(err_path.read_text()):
-                proc.send_signal(sig)
-                sent = True
-                break
-            time.sleep(0.002)
-        try:
-            code = proc.wait(timeout=TIMEOUT_S)
-        except subprocess.TimeoutExpired:  # pragma: no cover - a hang
-            proc.kill()
-            raise
-    return code, err_path.read_text(), sent
 
 
 def snapshot(folder: Path) -> dict[str, bytes]:
@@ -236,25 +209,19 @@ def trained_reference(tmp_path_factory):
 @pytest.mark.parametrize("sig,moment", [
     (signal.SIGINT, "generations"),
     (signal.SIGKILL, "generations"),
+    (signal.SIGINT, "final-choice"),
     (signal.SIGKILL, "final-choice"),
 ])
 def test_interrupted_training_resumes_to_the_uninterrupted_rulebook(
         run_cli, tmp_path, trained_reference, sig, moment):
+    # Interrupted at a known point through the CLI's test hook, not by polling: right after
+    # the checkpoint of generation 5, or after the last checkpoint while the final rulebook
+    # is being chosen (before it is written).
     out = tmp_path / "rb"
-    if moment == "generations":
-        def trigger(_stderr):
-            return history_rows(out) >= 5
-        args = train_args(out)
-    else:
-        # After the last checkpoint, while the final rulebook is chosen and written. Many
-        # validation runs keep that phase long enough to land in reliably (a race with the
-        # seven ~1 ms file writes alone would be flaky); the resumed run chooses with the
-        # reference's 2 runs, which the checkpoint does not fix.
-        def trigger(stderr):
-            return "choosing the rulebook" in stderr
-        args = train_args(out, validation_runs=400)
-    code, err, interrupted = run_interrupted(args, sig, trigger, tmp_path / "logs")
-    assert interrupted, f"training finished before the {moment!r} trigger: {err}"
+    name = "INT" if sig == signal.SIGINT else "KILL"
+    point = "generation:5" if moment == "generations" else "choice"
+    proc = run_with_hook(train_args(out), f"{name}@{point}")
+    code, err = proc.returncode, proc.stderr
     if sig == signal.SIGINT:
         assert code == 130, err
         assert "Traceback" not in err, err
@@ -262,6 +229,8 @@ def test_interrupted_training_resumes_to_the_uninterrupted_rulebook(
         assert temp_files(out) == []
     else:
         assert code == -signal.SIGKILL
+    assert history_rows(out) == (5 if moment == "generations" else history_rows(trained_reference))
+    assert not (out / "rulebook.toml").exists()  # interrupted before the rulebook was written
     check_train_folder(out)
 
     resumed = run_cli(*train_args(out, resume=True), timeout=TIMEOUT_S)

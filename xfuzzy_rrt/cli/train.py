@@ -138,10 +138,23 @@ def train(
                    scheduler=scheduler, name=name, scenario_args=[str(p) for p in scenario],
                    validation=held_out, validation_args=[str(p) for p in validation_scenario],
                    seed_rulebooks=seeds)
+    from xfuzzy_rrt.cli.common import test_signal
+
     progress = _Progress(generations)
+
+    def generation(row: dict) -> None:
+        progress.generation(row)
+        # test hook (XFUZZY_RRT_TEST_SIGNAL=SIG@generation:K): interrupt right after the
+        # checkpoint of generation K, a known point instead of a race with the file writes
+        test_signal(f"generation:{int(row['generation'])}")
+
+    def phase(text: str) -> None:
+        progress.phase(text)
+        test_signal("choice")  # after the last checkpoint, before the rulebook is written
+
     try:
-        result = run_training(job, on_start=progress.start, on_generation=progress.generation,
-                              on_chunk=progress.chunk, on_phase=progress.phase)
+        result = run_training(job, on_start=progress.start, on_generation=generation,
+                              on_chunk=progress.chunk, on_phase=phase)
     except KeyboardInterrupt:
         progress.phase("interrupted; the last complete generation is checkpointed: "
                        "continue with the same command plus --resume")

@@ -151,6 +151,8 @@ def bench_cmd(
     out = out if out is not None else folder / "robustness"
     _check_out(out)
     _analyse(paths, sigmas, base, trials, seed, workers, out, html)
+    if out.resolve() == (folder / "robustness").resolve():
+        typer.echo(f"add the robustness section to the bench report: xfuzzy-rrt report {folder}")
     return 0
 
 

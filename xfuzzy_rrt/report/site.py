@@ -232,6 +232,12 @@ def _overview(ctx) -> str:
     page.add(_ratio_plot(ctx, runs))
     page.heading("Certification: the worst path of each planner", anchor="certification")
     _certification(ctx, page, table_)
+    from xfuzzy_rrt.report.robustness_section import robustness_html
+
+    robust = robustness_html(ctx.get("folder"), F.planner_label)
+    if robust:
+        page.heading("Robustness: when the anatomy moves", anchor="robustness")
+        page.add(robust)
     page.heading("Rulebooks", anchor="rulebooks")
     _rulebook_list(ctx, page)
     page.heading("Scenarios", anchor="scenarios")

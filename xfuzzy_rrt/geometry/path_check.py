@@ -31,7 +31,8 @@ moves no more than the segment does), so on an interval ``[s0, s1]`` with end va
 ``c0, c1`` nothing is smaller than ``(c0 + c1 - M (s1 - s0)) / 2``. Intervals whose bound
 cannot beat the best value seen by more than ``MIN_CLEARANCE_TOL_M`` (0.1 um) are dropped,
 the others are halved (per link, with that link's own bound ``M_k``, which is tighter). The
-value returned is an exact distance at a real configuration on the path (``min_config_deg``),
+search itself is :func:`xfuzzy_rrt.geometry.clearance.min_clearance_kernel` (one
+implementation, shared with the robustness Monte Carlo). The value returned is an exact distance at a real configuration on the path (``min_config_deg``),
 and no configuration on the path is closer by more than 0.1 um.
 ``penetration_m`` is ``max(0, -min_clearance_m)``.
 """
@@ -182,153 +183,6 @@ def motion_bound(links, qa_deg, qb_deg):
 
 
 @nb.njit(cache=True, nogil=True)
-def _link_clearances(links, base, radius, obstacles, q_deg, out):
-    """``out[k]``: smallest signed clearance of link ``k`` to any obstacle; returns their min."""
-    best = np.inf
-    x = base[0]
-    y = base[1]
-    theta = 0.0
-    for k in range(links.shape[0]):
-        theta += math.radians(q_deg[k])
-        nx = x + links[k] * math.cos(theta)
-        ny = y + links[k] * math.sin(theta)
-        ck = np.inf
-        for o in range(obstacles.shape[0]):
-            d = signed_segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - radius
-            if d < ck:
-                ck = d
-        out[k] = ck
-        if ck < best:
-            best = ck
-        x = nx
-        y = ny
-    return best
-
-
-@nb.njit(cache=True, nogil=True)
-def _segment_min(links, base, radius, obstacles, qa, qb, ca, cb, tol, best, best_s,
-                 budget, stack_s, stack_c, q, cm):
-    """Branch and bound on one segment (see :func:`min_clearance_kernel`).
-
-    ``ca``/``cb`` are the per-link clearances at the ends. Returns ``(best, s of best, whether
-    best improved, evaluations used, lower bound of intervals dropped unrefined)``.
-    """
-    nl = links.shape[0]
-    m = np.empty(nl, dtype=np.float64)
-    p0 = np.empty(nl, dtype=np.float64)
-    p1 = np.empty(nl, dtype=np.float64)
-    for k in range(nl):
-        m[k] = link_motion_bound(links, qa, qb, k)
-    floor = np.inf
-    improved = False
-    evals = 0
-    depth_max = stack_s.shape[0]
-    stack_s[0, 0] = 0.0
-    stack_s[0, 1] = 1.0
-    stack_c[0, 0, :] = ca
-    stack_c[0, 1, :] = cb
-    top = 1
-    while top > 0:
-        top -= 1
-        s0 = stack_s[top, 0]
-        s1 = stack_s[top, 1]
-        h = s1 - s0
-        # Per link k, c_k is M_k-Lipschitz in s: nothing on [s0, s1] is below this.
-        lb = np.inf
-        for k in range(nl):
-            v = 0.5 * (stack_c[top, 0, k] + stack_c[top, 1, k] - m[k] * h)
-            if v < lb:
-                lb = v
-        if lb >= best - tol:
-            continue
-        sm = 0.5 * (s0 + s1)
-        if evals >= budget or top + 2 > depth_max or not (s0 < sm < s1):
-            if lb < floor:
-                floor = lb
-            continue
-        for d in range(q.shape[0]):
-            q[d] = qa[d] + sm * (qb[d] - qa[d])
-        c = _link_clearances(links, base, radius, obstacles, q, cm)
-        evals += 1
-        if c < best:
-            best = c
-            best_s = sm
-            improved = True
-        lo0 = np.inf
-        lo1 = np.inf
-        for k in range(nl):
-            p0[k] = stack_c[top, 0, k]
-            p1[k] = stack_c[top, 1, k]
-            lo0 = min(lo0, p0[k])
-            lo1 = min(lo1, p1[k])
-        # Two children; the one by the lower end is pushed last, so it is explored first.
-        left = top + 1 if lo0 <= lo1 else top
-        right = top if lo0 <= lo1 else top + 1
-        stack_s[left, 0] = s0
-        stack_s[left, 1] = sm
-        stack_s[right, 0] = sm
-        stack_s[right, 1] = s1
-        for k in range(nl):
-            stack_c[left, 0, k] = p0[k]
-            stack_c[left, 1, k] = cm[k]
-            stack_c[right, 0, k] = cm[k]
-            stack_c[right, 1, k] = p1[k]
-        top += 2
-    return best, best_s, improved, evals, floor
-
-
-@nb.njit(cache=True, nogil=True)
-def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals):
-    """Exact smallest signed clearance along ``path`` by Lipschitz branch and bound.
-
-    Returns ``(value, segment, s, lower bound, distance evaluations)``: ``value`` is attained at ``path[segment] +
-    s (path[segment + 1] - path[segment])`` and no configuration on the path has a signed
-    clearance below ``lower bound`` (``>= value - tol`` unless ``max_evals`` was reached).
-    Two passes: a coarse one (1 um) finds a near-optimal incumbent cheaply, so the fine one
-    only refines around the true minimum.
-    """
-    n = path.shape[0]
-    nl = links.shape[0]
-    if obstacles.shape[0] == 0 or n == 0:
-        return np.inf, -1, 0.0, np.inf, 0
-    cv = np.empty((n, nl), dtype=np.float64)
-    best = np.inf
-    best_seg = 0
-    best_s = 0.0
-    for i in range(n):
-        c = _link_clearances(links, base, radius, obstacles, path[i], cv[i])
-        if c < best:
-            best = c
-            if i < n - 1 or n == 1:
-                best_seg = i
-                best_s = 0.0
-            else:
-                best_seg = n - 2
-                best_s = 1.0
-    evals = n
-    floor = np.inf
-    depth_max = 200
-    stack_s = np.empty((depth_max, 2), dtype=np.float64)
-    stack_c = np.empty((depth_max, 2, nl), dtype=np.float64)
-    q = np.empty(path.shape[1], dtype=np.float64)
-    cm = np.empty(nl, dtype=np.float64)
-    for pass_tol in (max(tol, 1e-6), tol):
-        for i in range(n - 1):
-            got, s_got, improved, used, low = _segment_min(
-                links, base, radius, obstacles, path[i], path[i + 1], cv[i], cv[i + 1],
-                pass_tol, best, 0.0, max(0, max_evals - evals), stack_s, stack_c, q, cm)
-            evals += used
-            if improved:
-                best = got
-                best_seg = i
-                best_s = s_got
-            if pass_tol == tol and low < floor:
-                floor = low
-    lower = min(best - tol, floor)
-    return best, best_seg, best_s, lower, evals
-
-
-@nb.njit(cache=True, nogil=True)
 def certify_kernel(links, base, radius, obstacles, limits, path, margin):
     """``(certified, first uncertified segment, first vertex outside the limits)``."""
     n = path.shape[0]
@@ -366,9 +220,13 @@ def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
         raise InputError("path", f"must be an array of shape [n, {dof}], got {path.shape}")
     if not np.all(np.isfinite(path)):
         raise InputError("path", "contains non-finite angles")
-    value, seg, s, lower, _ = min_clearance_kernel(
-        arrays.links, arrays.base, arrays.link_radius, arrays.obstacles, path,
-        MIN_CLEARANCE_TOL_M, MIN_CLEARANCE_MAX_EVALS)
+    # one branch and bound for the whole project (geometry/clearance.py; the robustness Monte
+    # Carlo uses it too), here at the certification's tolerance and without the contact refinement
+    from xfuzzy_rrt.geometry.clearance import min_clearance_kernel
+
+    value, seg, s, lower = min_clearance_kernel(
+        arrays.links, arrays.base, float(arrays.link_radius), arrays.obstacles, path,
+        MIN_CLEARANCE_TOL_M, MIN_CLEARANCE_MAX_EVALS, False)
     value = float(value)
     if float(lower) < value - MIN_CLEARANCE_TOL_M:
         value = float(lower)  # budget reached: report the proven bound, never an optimistic one

@@ -29,7 +29,7 @@ import pytest
 CHROMIUM = Path(os.environ.get("XFUZZY_CHROMIUM", "/usr/bin/chromium"))
 ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
         "--disable-component-update", "--disable-sync", "--no-first-run"]
-PLANNERS = ["rrt", "fuzzy-rrt:general", "fuzzy-rrt:paper", "ompl:RRTConnect"]
+PLANNERS = ["rrt", "fuzzy-rrt:goal-frame", "fuzzy-rrt:paper", "ompl:RRTConnect"]  # the default and the paper rulebook
 N_SCENARIOS = 24
 #: The overview must respond within this time (issue 16) and weigh at most this much (without
 #: the shared plotly.js).
@@ -137,7 +137,7 @@ def test_overview_answers_on_the_first_screen_within_two_seconds(browser, site, 
     for sel, (top, bottom, width) in boxes.items():
         assert 0 <= top < bottom <= 900 and width > 600, (sel, top, bottom)
     verdict = page.text_content("#verdict")
-    assert "Fuzzy-RRT general" in verdict and "Fuzzy-RRT paper" in verdict
+    assert "Fuzzy-RRT goal-frame" in verdict and "Fuzzy-RRT paper" in verdict
     assert "OMPL RRTConnect finds its first path" in verdict
     assert f"on {N_SCENARIOS} problems" in verdict
     points = page.eval_on_selector_all("#ratio-plot a.xf-point", "els => els.length")
@@ -205,18 +205,18 @@ def test_drilldown_slider_shows_the_chosen_iteration(browser, site):
     from xfuzzy_rrt.report.numbers import readable_numbers
 
     bench = json.loads((site / "bench.json").read_text())
-    rb_dir = next(e["dir"] for e in bench["rulebooks"] if e["planner"] == "fuzzy-rrt:general")
+    rb_dir = next(e["dir"] for e in bench["rulebooks"] if e["planner"] == "fuzzy-rrt:goal-frame")
     rb = load_rulebook(rb_dir)
     path = next(p for p in sorted((site / "report").glob("scenario-*.html"))
                 if 'id="drill-s1-data"' in p.read_text(encoding="utf-8"))
     html = path.read_text(encoding="utf-8")
     data = json.loads(re.search(r'<script type="application/json" id="drill-s1-data">(.*?)'
                                 r"</script>", html, re.S).group(1))
-    assert data["rulebook"] == "general"
+    assert data["rulebook"] == "goal-frame"
     page, seen = _open(browser, path.as_uri())
     last = len(data["iterations"]) - 1
     record = data["iterations"][last]
-    root = "#follow-fuzzy-rrt-general ~ .xf-drill"
+    root = "#follow-fuzzy-rrt-goal-frame ~ .xf-drill"
     page.eval_on_selector(f"{root} input[type=range]",
                           f"s => {{ s.value = {last}; s.dispatchEvent(new Event('input')); }}")
     page.wait_for_timeout(300)

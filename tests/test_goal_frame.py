@@ -313,3 +313,15 @@ def test_protocol_with_a_clearance_skips_problems_whose_ends_cannot_keep_it(tmp_
     assert ok.returncode == 0, ok.stderr
     runs = pd.read_csv(tmp_path / "o" / "runs.csv")
     assert runs["success"].all()
+
+
+def test_explain_says_what_goal_frame_inputs_measure(tmp_path, run_cli):
+    trace = tmp_path / "t.csv"
+    assert run_cli("plan", SCENARIOS[0], "--seed", "1", "--trace", trace).returncode == 0
+    for extra in ((), ("--exact",)):
+        proc = run_cli("explain", trace, "--iteration", "2", *extra)
+        assert proc.returncode == 0, proc.stderr
+        head = proc.stdout.splitlines()
+        assert head[0].endswith("(goal-frame semantics)")
+        assert head[2].startswith("Inputs (measured at the current node, in joint space")
+        assert "sampling region" in proc.stdout and "end effector" not in proc.stdout

@@ -157,13 +157,19 @@ def explain_row(row: pd.Series, rulebook) -> Explanation:
                        systems=tuple(systems), decision=decision)
 
 
+def header_lines(e: Explanation) -> list[str]:
+    """The first lines of every rendering: iteration, rulebook, what the inputs measure."""
+    if e.bounds_mode:  # the paper's semantics
+        kind, where = f"bounds: {e.bounds_mode}", "measured from the end effector of the current node"
+    else:
+        kind, where = "goal-frame semantics", "measured at the current node, in joint space"
+    return [f"Iteration {e.iteration} \u2014 rulebook {e.rulebook!r} ({kind})", "",
+            f"Inputs ({where}; clamped to the ranges):"]
+
+
 def render_text(e: Explanation) -> str:
     """A plain-text rendering (what ``xfuzzy-rrt explain`` prints)."""
-    where = ("measured from the end effector of the current node" if e.bounds_mode
-             else "measured at the current node in joint space")
-    lines = [f"Iteration {e.iteration} — rulebook {e.rulebook!r} "
-             f"({'bounds: ' + e.bounds_mode if e.bounds_mode else 'goal-frame semantics'})", "",
-             f"Inputs ({where}; clamped to the ranges):"]
+    lines = header_lines(e)
     for name in e.inputs:
         raw, c = e.inputs[name], e.clamped_inputs[name]
         note = "" if raw == c else f" (measured {raw!r}, clamped)"
@@ -180,7 +186,12 @@ def render_text(e: Explanation) -> str:
     d = e.decision
     if d:
         lines += ["", "Decision:"]
-        if "box_q1_lo" in d:
+        if "box_q1_lo" in d and not e.bounds_mode:
+            lines.append(f"  sampling region (bounding box of the box along the direction to the "
+                         f"goal, or the whole joint space for a uniform sample): joint 1 "
+                         f"[{d['box_q1_lo']:.6g}, {d['box_q1_hi']:.6g}] deg, joint 2 "
+                         f"[{d['box_q2_lo']:.6g}, {d['box_q2_hi']:.6g}] deg")
+        elif "box_q1_lo" in d:
             lines.append(f"  sampling box: joint 1 [{d['box_q1_lo']:.6g}, {d['box_q1_hi']:.6g}] deg, "
                          f"joint 2 [{d['box_q2_lo']:.6g}, {d['box_q2_hi']:.6g}] deg"
                          + (f" (bounds offset from node {int(d['from_node'])} at "
@@ -189,7 +200,8 @@ def render_text(e: Explanation) -> str:
         if "step_used_deg" in d:
             lines.append(f"  step used: {d['step_used_deg']:.6g} deg")
         if "sample_q1_deg" in d:
-            src = "the goal (goal bias)" if bool(d.get("goal_sampled")) else "uniform in the box"
+            src = ("the goal (goal bias)" if bool(d.get("goal_sampled"))
+                   else "uniform in the box" if e.bounds_mode else "uniform in the region")
             lines.append(f"  sample: [{d['sample_q1_deg']:.6g}, {d['sample_q2_deg']:.6g}] from {src}")
         if "nearest_node" in d:
             lines.append(f"  nearest node: {int(d['nearest_node'])}; new configuration "

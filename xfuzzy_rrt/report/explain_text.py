@@ -46,11 +46,9 @@ def input_note(raw: float, clamped: float, unit: str = "") -> str:
 
 def render_readable(e, units: dict[str, str]) -> str:
     """The explanation ``e`` (:class:`~xfuzzy_rrt.analysis.explain.Explanation`) as text."""
-    from xfuzzy_rrt.analysis.explain import render_text
+    from xfuzzy_rrt.analysis.explain import header_lines, render_text
 
-    lines = [f"Iteration {e.iteration} \u2014 rulebook {e.rulebook!r} (bounds: {e.bounds_mode})",
-             "", "Inputs (measured from the end effector of the current node; clamped to the "
-             "ranges):"]
+    lines = header_lines(e)
     for name in e.inputs:
         c = e.clamped_inputs[name]
         note = input_note(e.inputs[name], c, units.get(name, ""))

@@ -69,6 +69,14 @@ class Arm:
 
 @dataclass(frozen=True)
 class Scenario:
+    """A planning problem: one or more arms, their start and goal, and the obstacles.
+
+    ``arm`` is the first arm and ``more_arms`` the others (empty for the format's single
+    ``[arm]``), so every single-arm caller keeps reading ``scenario.arm``. ``start_deg`` and
+    ``goal_deg`` hold every arm's joint angles, arm after arm: the planners search the joint
+    space of all arms together (``dof`` angles).
+    """
+
     name: str
     arm: Arm
     start_deg: tuple[float, ...]
@@ -78,6 +86,32 @@ class Scenario:
     source: str = ""
     #: ``[safety] clearance_m``: the distance (m) every link should keep from every obstacle.
     clearance_m: float = 0.0
+    #: Arms after the first (``[[arms]]`` entries 2, 3, ...); each is a collision object for
+    #: the others.
+    more_arms: tuple[Arm, ...] = ()
+    #: Optional ``[[arms]] name`` of each arm (empty strings when unnamed).
+    arm_names: tuple[str, ...] = ()
+
+    @property
+    def arms(self) -> tuple[Arm, ...]:
+        return (self.arm, *self.more_arms)
+
+    @property
+    def dof(self) -> int:
+        """Joint angles of all arms together (the dimension the planners search)."""
+        return sum(a.dof for a in self.arms)
+
+    @property
+    def joint_limits_deg(self) -> tuple[tuple[float, float], ...]:
+        return tuple(lim for a in self.arms for lim in a.joint_limits_deg)
+
+    def arm_slices(self) -> tuple[slice, ...]:
+        """Where each arm's angles sit in ``start_deg``, ``goal_deg`` and every path row."""
+        out, k = [], 0
+        for a in self.arms:
+            out.append(slice(k, k + a.dof))
+            k += a.dof
+        return tuple(out)
 
     def arrays(self) -> "ScenarioArrays":
         """The flat arrays compiled code works on (see :class:`ScenarioArrays`)."""
@@ -89,7 +123,10 @@ class ScenarioArrays:
     """A scenario as contiguous float64 arrays for numba kernels.
 
     ``obstacles`` rows are ``[kind, a, b, c, d]``: circles ``[0, cx, cy, r, 0]``, boxes
-    ``[1, xmin, ymin, xmax, ymax]``. ``limits_deg`` is ``[dof, 2]``.
+    ``[1, xmin, ymin, xmax, ymax]``. ``limits_deg`` is ``[dof, 2]``. ``links`` lists every
+    arm's links, arm after arm; arm ``a`` owns links (and joints) ``arm_first[a]`` to
+    ``arm_first[a + 1] - 1``, turns about ``bases[a]`` and has capsule radius ``radii[a]``.
+    ``base``/``link_radius`` are the first arm's (single-arm helpers read them).
     """
 
     links: np.ndarray
@@ -99,6 +136,17 @@ class ScenarioArrays:
     limits_deg: np.ndarray
     start_deg: np.ndarray
     goal_deg: np.ndarray
+    arm_first: np.ndarray
+    bases: np.ndarray
+    radii: np.ndarray
+
+    @property
+    def n_arms(self) -> int:
+        return int(self.arm_first.shape[0] - 1)
+
+    @property
+    def dof(self) -> int:
+        return int(self.links.shape[0])
 
     @classmethod
     def from_scenario(cls, s: Scenario) -> "ScenarioArrays":
@@ -108,15 +156,29 @@ class ScenarioArrays:
                 obs[i] = (CIRCLE, o.center[0], o.center[1], o.radius, 0.0)
             else:
                 obs[i] = (BOX, o.min[0], o.min[1], o.max[0], o.max[1])
+        arms = s.arms
+        first = np.zeros(len(arms) + 1, dtype=np.int64)
+        for a, arm in enumerate(arms):
+            first[a + 1] = first[a] + arm.dof
         return cls(
-            links=np.asarray(s.arm.links, dtype=np.float64),
+            links=np.asarray([v for arm in arms for v in arm.links], dtype=np.float64),
             base=np.asarray(s.arm.base, dtype=np.float64),
             link_radius=float(s.arm.link_radius),
             obstacles=obs,
-            limits_deg=np.asarray(s.arm.joint_limits_deg, dtype=np.float64).reshape(-1, 2),
+            limits_deg=np.asarray(s.joint_limits_deg, dtype=np.float64).reshape(-1, 2),
             start_deg=np.asarray(s.start_deg, dtype=np.float64),
             goal_deg=np.asarray(s.goal_deg, dtype=np.float64),
+            arm_first=first,
+            bases=np.asarray([arm.base for arm in arms], dtype=np.float64).reshape(-1, 2),
+            radii=np.asarray([arm.link_radius for arm in arms], dtype=np.float64),
         )
+
+    def problem(self, margin: float):
+        """The compiled problem bundle every kernel takes (:class:`~xfuzzy_rrt.geometry.problem.Problem`)."""
+        from xfuzzy_rrt.geometry.problem import Problem
+
+        return Problem(self.links, self.arm_first, self.bases, self.radii, self.obstacles,
+                       self.limits_deg, self.start_deg, self.goal_deg, float(margin))
 
 
 # --------------------------------------------------------------------------------------------

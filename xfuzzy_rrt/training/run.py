@@ -67,12 +67,12 @@ def expand_scenarios(paths: list[Path]) -> list[Path]:
 
 def load_training_scenarios(paths: list[Path]) -> list[TrainingScenario]:
     from xfuzzy_rrt.geometry.scenario import load_scenario
-    from xfuzzy_rrt.planners.checks import check_planar_2dof
+    from xfuzzy_rrt.planners.checks import check_dof
 
     items = []
     for p in expand_scenarios(paths):
         s = load_scenario(p)
-        check_planar_2dof(s)
+        check_dof(s)
         items.append(TrainingScenario(path=str(p), sha256=hashlib.sha256(p.read_bytes()).hexdigest(),
                                       scenario=s))
     names = [t.scenario.name for t in items]

@@ -279,9 +279,15 @@ _check()
 
 
 def of_columns(columns) -> Semantics:
-    """The semantics whose inputs name columns of a trace or table (the paper's by default)."""
-    cols = set(columns)
-    for s in SEMANTICS.values():
-        if s.inputs[0] in cols:
-            return s
-    return DEFAULT
+    """The semantics whose inputs name columns of a trace or table (the paper's by default),
+    at the DOF its output columns show (``bound_1 … bound_2N``; goal-frame's outputs do not
+    depend on the DOF, so it comes back at 2 there, with the same output names)."""
+    cols = {str(c) for c in columns}
+    base = next((s for s in SEMANTICS.values() if s.inputs[0] in cols), DEFAULT)
+    if base.name == PAPER.name:
+        k = 4
+        while f"bound_{k + 1}" in cols:
+            k += 1
+        if k % 2 == 0 and MIN_DOF <= k // 2 <= MAX_DOF:
+            return get(base.name, k // 2)
+    return base

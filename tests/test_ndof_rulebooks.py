@@ -423,3 +423,38 @@ def test_coverage_counts_a_trace_with_one_block_per_output():
     for o in rb.outputs:
         assert cov[cov["output"] == o]["mass_share"].sum() == pytest.approx(1.0)
     assert set(top_rules(trace, 2)["output"]) == set(rb.outputs)
+
+
+def test_explain_recomputes_an_ndof_row_and_shows_every_joint():
+    """``explain`` on a trace row of a 5-joint run (made here by the engine; the planner's
+    trace has the same columns): every FIS recomputed, the box and sample in all five joints."""
+    import pandas as pd
+
+    from xfuzzy_rrt.analysis.explain import explain_row, render_text, trace_joints
+    from xfuzzy_rrt.fuzzy.engine import infer, new_trace_buffers
+
+    rb = ndof_rulebook(5, seed=9)
+    knots, consts = rb.compiled
+    n_out = knots.shape[0]
+    x = np.array([1.0, 0.2, 4.0, 0.1])
+    out = np.empty(n_out)
+    rule, w = new_trace_buffers(n_out)
+    infer(knots, consts, x, out, rule, w, True)
+    row = {"iteration": 3, "rulebook_sha256": rb.sha256, **dict(zip(rb.inputs, x)),
+           **dict(zip(rb.outputs, out)), "from_node": 0, "step_used_deg": 10.0,
+           "goal_sampled": False, "nearest_node": 0, "outcome": "added", "new_node": 1,
+           "tree_size": 2, "on_path": False}
+    for j in range(1, 6):
+        row.update({f"from_q{j}_deg": 10.0 * j, f"box_q{j}_lo": -j, f"box_q{j}_hi": j,
+                    f"sample_q{j}_deg": 0.5 * j, f"new_q{j}_deg": 0.25 * j})
+    for f, o in enumerate(rb.outputs):
+        row.update({f"{o}_rule_{k}": int(rule[f, k]) for k in range(16)})
+        row.update({f"{o}_strength_{k}": float(w[f, k]) for k in range(16)})
+    series = pd.Series(row)
+    assert trace_joints(series.index) == [1, 2, 3, 4, 5]
+    e = explain_row(series, rb)
+    assert [s.output for s in e.systems] == list(rb.outputs)
+    assert e.max_discrepancy < 1e-12
+    text = render_text(e)
+    assert "== bound_10 ==" in text and "joint 5 [-5, 5] deg" in text
+    assert "sample: [0.5, 1, 1.5, 2, 2.5]" in text and "[10, 20, 30, 40, 50]" in text

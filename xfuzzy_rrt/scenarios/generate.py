@@ -21,6 +21,10 @@ straight-line length and the fraction of C-space in collision.
 
 The problems depend only on ``seed``: draw ``k`` uses ``numpy.random.default_rng([seed, k])``,
 so ``--count 24`` starts with the same problems as ``--count 8``.
+
+``--dof N`` (joints per arm) and ``--arms K`` select the N-DOF / multi-arm family instead
+(:func:`generate_nd`; docs/scenarios.md): no C-space grid there (the joint space is not a
+plane), so solvability is shown by a certified RRT path alone, recorded in the description.
 """
 
 from __future__ import annotations

@@ -32,9 +32,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, clearance
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, clearance, clearance_kernel
 from xfuzzy_rrt.geometry.scenario import Arm, Box, Circle, Scenario
 from xfuzzy_rrt.scenarios.writer import scenario_toml  # noqa: F401  (re-exported)
 
@@ -143,24 +144,28 @@ def _draw_mira(rng: np.random.Generator, name: str) -> Scenario:
                     obstacles=tuple(obstacles))
 
 
-def c_space_grid(scenario: Scenario, step_deg: float = GRID_DEG) -> tuple[np.ndarray, np.ndarray]:
-    """``(angles, free)``: grid angles and a boolean [n, n] map of free configurations.
-
-    Only for a single 2-DOF arm (the map is the whole joint space). Each cell is one call of
-    :func:`~xfuzzy_rrt.geometry.collision.clearance`, the certified checker's own distance.
-    """
-    if len(scenario.arms) != 1 or scenario.arm.dof != 2:
-        raise ValueError("the C-space grid needs one 2-DOF arm")
-    a = scenario.arrays()
-    angles = np.arange(-180.0, 180.0 + 1e-9, step_deg)
+@nb.njit(cache=True, nogil=True)
+def _free_grid(P, angles, margin):
     free = np.empty((angles.size, angles.size), dtype=np.bool_)
     q = np.empty(2)
     for i in range(angles.size):
         q[0] = angles[i]
         for j in range(angles.size):
             q[1] = angles[j]
-            free[i, j] = clearance(a, q) > CERT_MARGIN_M
-    return angles, free
+            free[i, j] = clearance_kernel(P, q) > margin
+    return free
+
+
+def c_space_grid(scenario: Scenario, step_deg: float = GRID_DEG) -> tuple[np.ndarray, np.ndarray]:
+    """``(angles, free)``: grid angles and a boolean [n, n] map of free configurations.
+
+    Only for a single 2-DOF arm (the map is then the whole joint space).
+    """
+    if len(scenario.arms) != 1 or scenario.arm.dof != 2:
+        raise ValueError("the C-space grid needs one 2-DOF arm")
+    a = scenario.arrays()
+    angles = np.arange(-180.0, 180.0 + 1e-9, step_deg)
+    return angles, _free_grid(a.problem(CERT_MARGIN_M), angles, CERT_MARGIN_M)
 
 
 def grid_optimal_deg(scenario: Scenario, step_deg: float = GRID_DEG,

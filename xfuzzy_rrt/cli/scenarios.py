@@ -1,4 +1,5 @@
-"""``xfuzzy-rrt scenarios generate``: fresh problems of the shared ``sample-*`` family."""
+"""``xfuzzy-rrt scenarios generate``: fresh problems of the shared ``sample-*`` family and of
+the N-DOF (``--dof N``) and multi-arm (``--arms K``) family."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ from typing import Optional
 
 import typer
 
-app = typer.Typer(help="Scenario files: generate problems of the sample-* family.",
+app = typer.Typer(help="Scenario files: generate problems of the sample-* family, N-DOF arms or several arms.",
                   no_args_is_help=True, add_completion=False, rich_markup_mode=None)
 
 
@@ -17,27 +18,44 @@ def generate(
     seed: int = typer.Option(0, "--seed", min=0, help="Generator seed: same seed, same files."),
     out: Path = typer.Option(..., "--out", help="Folder to write <name>.toml files into."),
     prefix: Optional[str] = typer.Option(None, "--prefix", help="Name prefix: <prefix>-<seed>-<k> (default: gen for the sample family, else the family's name)."),
-    family: str = typer.Option("sample", "--family", help="sample (the shared sample-* family), hard (cluttered, thin walls, narrow passages) or mira (MIRA-like arm threading a gap between organs)."),
+    family: Optional[str] = typer.Option(None, "--family", help="2-DOF single-arm families: sample (the shared sample-* family; the default), hard (cluttered, thin walls, narrow passages) or mira (MIRA-like arm threading a gap between organs)."),
+    dof: int = typer.Option(2, "--dof", help="Joints per arm, 2 to 7 (default 2). Other than 2 selects the N-DOF family (see docs/scenarios.md)."),
+    arms: int = typer.Option(1, "--arms", help="Arms sharing the workspace, 1 to 4 (default 1). More than 1 writes [[arms]] files whose arms can touch each other."),
 ) -> int:
     """Write COUNT valid, solvable, non-trivial scenarios (straight segment blocked)."""
     import re
 
     from xfuzzy_rrt.atomic import write_text_atomic
     from xfuzzy_rrt.errors import InputError
-    from xfuzzy_rrt.scenarios.generate import FAMILIES, generate_one
+    from xfuzzy_rrt.scenarios.generate import (FAMILIES, MAX_ARMS, MAX_DOF, MIN_ARMS, MIN_DOF,
+                                               generate_one, nd_prefix)
 
+    if not MIN_DOF <= dof <= MAX_DOF:
+        raise InputError("--dof", f"must be {MIN_DOF} to {MAX_DOF} joints per arm, got {dof}")
+    if not MIN_ARMS <= arms <= MAX_ARMS:
+        raise InputError("--arms", f"must be {MIN_ARMS} to {MAX_ARMS}, got {arms}")
+    nd = dof != 2 or arms != 1
+    if nd and family is not None:
+        raise InputError("--family", f"applies to one 2-DOF arm; --dof {dof} --arms {arms} has "
+                         f"its own family (leave --family out)")
+    family = "sample" if family is None else family
     if family not in FAMILIES:
         raise InputError("--family", f"must be one of {', '.join(FAMILIES)}, got {family!r}")
     if prefix is None:
-        prefix = "gen" if family == "sample" else family
+        prefix = nd_prefix(dof, arms) if nd else ("gen" if family == "sample" else family)
     if not re.fullmatch(r"[A-Za-z0-9_-]+", prefix):
         raise InputError("--prefix", f"must be letters, digits, '-' or '_', got {prefix!r}")
     if out.exists() and not out.is_dir():
         raise InputError(str(out), "exists and is not a directory")
     for k in range(count):
-        problem = generate_one(seed, k, prefix, family)
+        problem = generate_one(seed, k, prefix, family, dof=dof, arms=arms)
         path = out / f"{problem.scenario.name}.toml"
         write_text_atomic(path, problem.text)
+        if nd:
+            typer.echo(f"{path}: {problem.scenario.dof} joints in all, straight "
+                       f"{problem.straight_deg:.1f} deg, rrt solved it in "
+                       f"{problem.solved_iterations} iterations (seed {problem.solved_seed})")
+            continue
         grid = (f"grid-optimal {problem.grid_optimal_deg:.1f} deg"
                 if problem.grid_optimal_deg < float("inf") else "no path on the 2 deg grid")
         typer.echo(f"{path}: {grid}, straight "

@@ -7,7 +7,9 @@ error too, with its line and the nearest known name (see :mod:`xfuzzy_rrt.strict
 as ``[[obstacle]]`` must never silently remove every obstacle.
 
 The format is described in ``shared/scenarios/FORMAT.md``: metres for lengths, degrees for joint
-angles, circles and axis-aligned boxes as obstacles, N links.
+angles, circles and axis-aligned boxes as obstacles, N links. The project's compatible extension
+for several arms (an ``[[arms]]`` array, each arm with its own ``start_deg`` and ``goal_deg``) is
+described in ``docs/scenarios.md``.
 """
 
 from __future__ import annotations
@@ -186,8 +188,15 @@ class ScenarioArrays:
 # --------------------------------------------------------------------------------------------
 
 #: Known keys, spelt as the format writes them (tables in brackets), for the "did you mean".
-_TOP_KEYS = ("name", "description", "[arm]", "[safety]", "[start]", "[goal]", "[[obstacles]]")
+_TOP_KEYS = ("name", "description", "[arm]", "[safety]", "[start]", "[goal]", "[[obstacles]]",
+             "[[arms]]")
 _ARM_KEYS = ("links", "base", "link_radius", "joint_limits_deg")
+#: Keys of one ``[[arms]]`` entry (the project's extension for several arms, docs/scenarios.md).
+_ARMS_KEYS = ("name", "links", "base", "link_radius", "joint_limits_deg", "start_deg", "goal_deg")
+
+#: The ``[[arms]]`` form's limits: the planners search at most 4 arms of at most 7 links each.
+MAX_ARMS = 4
+MAX_LINKS_PER_ARM = 7
 _SAFETY_KEYS = ("clearance_m",)
 _CONFIG_KEYS = ("q_deg",)
 _CIRCLE_KEYS = ("type", "center", "radius")
@@ -213,6 +222,11 @@ class _Reader:
                 line = toml_key_line(self.text, (*path, key)) if self.text is not None else None
                 file = f"{self.file}:{line}" if line is not None else self.file
                 raise ScenarioError(file, "", unknown_key_message(key, known, where))
+
+    def fail_at(self, path: tuple, key: str, message: str) -> ScenarioError:
+        """:meth:`fail` with the line of ``path`` in the text, when the scan can place it."""
+        line = toml_key_line(self.text, path) if self.text is not None else None
+        return ScenarioError(f"{self.file}:{line}" if line is not None else self.file, key, message)
 
     def table(self, data: dict[str, Any], key: str, path: str, required: bool = True) -> dict | None:
         if key not in data:
@@ -303,6 +317,9 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>",
     """Validate an already-parsed scenario mapping (the loader's second half).
 
     ``text``, the TOML it was parsed from, lets an unknown key be reported with its line.
+    A file describes its arm(s) one of two ways (see ``docs/scenarios.md``): the format's
+    ``[arm]`` with top-level ``[start]`` and ``[goal]``, or the project's ``[[arms]]`` array,
+    each entry with its own ``start_deg`` and ``goal_deg``. Mixing them is an error.
     """
     r = _Reader(file, text)
     r.only(data, _TOP_KEYS)
@@ -314,39 +331,22 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>",
     if not isinstance(description, str):
         raise r.fail("description", f"must be a string, got {_typename(description)}")
 
-    arm_t = r.table(data, "arm", "arm")
-    r.only(arm_t, _ARM_KEYS, ("arm",), "[arm]")
-    links_raw = r.required(arm_t, "links", "arm.links")
-    links = r.lengths(links_raw, "arm.links")
-    if not links:
-        raise r.fail("arm.links", "must list at least one link length")
-    for i, length in enumerate(links):
-        if length <= 0:
-            raise r.fail(f"arm.links[{i}]", f"link length must be > 0, got {length:g}")
-    base = r.lengths(arm_t.get("base", [0.0, 0.0]), "arm.base", length=2)
-    link_radius = r.extent(r.number(arm_t.get("link_radius", 0.0), "arm.link_radius"),
-                           "arm.link_radius")
-    if link_radius < 0:
-        raise r.fail("arm.link_radius", f"must be >= 0, got {link_radius:g}")
-    dof = len(links)
-    limits_raw = arm_t.get("joint_limits_deg", [[-180.0, 180.0]] * dof)
-    if not isinstance(limits_raw, list):
-        raise r.fail("arm.joint_limits_deg", f"must be an array of [min, max] pairs, got "
-                     f"{_typename(limits_raw)}")
-    if len(limits_raw) != dof:
-        raise r.fail("arm.joint_limits_deg", f"must have one [min, max] pair per link ({dof}), "
-                     f"got {len(limits_raw)}")
-    limits = []
-    for i, pair in enumerate(limits_raw):
-        lo, hi = r.numbers(pair, f"arm.joint_limits_deg[{i}]", length=2)
-        if not lo < hi:
-            raise r.fail(f"arm.joint_limits_deg[{i}]", f"min must be < max, got [{lo:g}, {hi:g}]")
-        if lo < -180.0 or hi > 180.0:
-            raise r.fail(f"arm.joint_limits_deg[{i}]",
-                         f"must lie within [-180, 180] (no wrap-around), got [{lo:g}, {hi:g}]")
-        limits.append((lo, hi))
-    arm = Arm(links=links, base=(base[0], base[1]), link_radius=link_radius,
-              joint_limits_deg=tuple(limits))
+    if "arms" in data:
+        arms, names, start, goal = _read_arms(r, data)
+    else:
+        arm_t = r.table(data, "arm", "arm")
+        r.only(arm_t, _ARM_KEYS, ("arm",), "[arm]")
+        arm = _read_arm(r, arm_t, "arm")
+        dof = arm.dof
+        configs = {}
+        for which in ("start", "goal"):
+            t = r.table(data, which, which)
+            r.only(t, _CONFIG_KEYS, (which,), f"[{which}]")
+            q_raw = r.required(t, "q_deg", f"{which}.q_deg")
+            if isinstance(q_raw, list) and len(q_raw) != dof:
+                raise r.fail(f"{which}.q_deg", f"must have one angle per link ({dof}), got {len(q_raw)}")
+            configs[which] = r.numbers(q_raw, f"{which}.q_deg", length=dof)
+        arms, names, start, goal = (arm,), (), configs["start"], configs["goal"]
 
     safety_t = r.table(data, "safety", "safety", required=False) or {}
     r.only(safety_t, _SAFETY_KEYS, ("safety",), "[safety]")
@@ -354,15 +354,6 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>",
                            "safety.clearance_m")
     if clearance_m < 0:
         raise r.fail("safety.clearance_m", f"must be >= 0, got {clearance_m:g}")
-
-    configs = {}
-    for which in ("start", "goal"):
-        t = r.table(data, which, which)
-        r.only(t, _CONFIG_KEYS, (which,), f"[{which}]")
-        q_raw = r.required(t, "q_deg", f"{which}.q_deg")
-        if isinstance(q_raw, list) and len(q_raw) != dof:
-            raise r.fail(f"{which}.q_deg", f"must have one angle per link ({dof}), got {len(q_raw)}")
-        configs[which] = r.numbers(q_raw, f"{which}.q_deg", length=dof)
 
     obstacles: list[Obstacle] = []
     obs_raw = data.get("obstacles", [])
@@ -396,25 +387,118 @@ def scenario_from_dict(data: dict[str, Any], file: str = "<scenario>",
             raise r.fail(f"{key}.type", f"unknown obstacle type {kind!r} (expected 'circle' or 'box')")
 
     scenario = Scenario(
-        name=name.strip(), arm=arm, start_deg=configs["start"], goal_deg=configs["goal"],
+        name=name.strip(), arm=arms[0], start_deg=start, goal_deg=goal,
         obstacles=tuple(obstacles), description=description, source=file,
-        clearance_m=clearance_m,
+        clearance_m=clearance_m, more_arms=tuple(arms[1:]), arm_names=names,
     )
-    _check_endpoints(scenario, r)
+    _check_endpoints(scenario, r, "arms" in data)
     return scenario
 
 
-def _check_endpoints(s: Scenario, r: _Reader) -> None:
-    """Start and goal must be within the joint limits and collision-free (touching counts)."""
+def _read_arm(r: _Reader, arm_t: dict[str, Any], key: str) -> Arm:
+    """One arm's ``links``, ``base``, ``link_radius`` and ``joint_limits_deg`` (``key``: where)."""
+    links_raw = r.required(arm_t, "links", f"{key}.links")
+    links = r.lengths(links_raw, f"{key}.links")
+    if not links:
+        raise r.fail(f"{key}.links", "must list at least one link length")
+    for i, length in enumerate(links):
+        if length <= 0:
+            raise r.fail(f"{key}.links[{i}]", f"link length must be > 0, got {length:g}")
+    base = r.lengths(arm_t.get("base", [0.0, 0.0]), f"{key}.base", length=2)
+    link_radius = r.extent(r.number(arm_t.get("link_radius", 0.0), f"{key}.link_radius"),
+                           f"{key}.link_radius")
+    if link_radius < 0:
+        raise r.fail(f"{key}.link_radius", f"must be >= 0, got {link_radius:g}")
+    dof = len(links)
+    limits_raw = arm_t.get("joint_limits_deg", [[-180.0, 180.0]] * dof)
+    if not isinstance(limits_raw, list):
+        raise r.fail(f"{key}.joint_limits_deg", f"must be an array of [min, max] pairs, got "
+                     f"{_typename(limits_raw)}")
+    if len(limits_raw) != dof:
+        raise r.fail(f"{key}.joint_limits_deg", f"must have one [min, max] pair per link "
+                     f"({dof}), got {len(limits_raw)}")
+    limits = []
+    for i, pair in enumerate(limits_raw):
+        lo, hi = r.numbers(pair, f"{key}.joint_limits_deg[{i}]", length=2)
+        if not lo < hi:
+            raise r.fail(f"{key}.joint_limits_deg[{i}]", f"min must be < max, got [{lo:g}, {hi:g}]")
+        if lo < -180.0 or hi > 180.0:
+            raise r.fail(f"{key}.joint_limits_deg[{i}]",
+                         f"must lie within [-180, 180] (no wrap-around), got [{lo:g}, {hi:g}]")
+        limits.append((lo, hi))
+    return Arm(links=links, base=(base[0], base[1]), link_radius=link_radius,
+               joint_limits_deg=tuple(limits))
+
+
+def _read_arms(r: _Reader, data: dict[str, Any]):
+    """The ``[[arms]]`` form: ``(arms, names, start_deg, goal_deg)``, angles arm after arm."""
+    raw = data["arms"]
+    if "arm" in data:
+        raise r.fail_at(("arms",), "arms", "a file has either [arm] (with [start] and [goal]) or "
+                        "[[arms]], not both")
+    for which in ("start", "goal"):
+        if which in data:
+            raise r.fail_at((which,), which, f"[{which}] is not used with [[arms]]: each arm "
+                            f"carries its own start_deg and goal_deg")
+    if not isinstance(raw, list) or not all(isinstance(t, dict) for t in raw):
+        got = _typename(raw) if not isinstance(raw, list) else "an array with a non-table entry"
+        raise r.fail("arms", f"must be an array of tables ([[arms]]), got {got}")
+    if not raw:
+        raise r.fail("arms", "must list at least one arm")
+    if len(raw) > MAX_ARMS:
+        raise r.fail("arms", f"at most {MAX_ARMS} arms are supported, got {len(raw)}")
+    arms, names, start, goal = [], [], [], []
+    for i, t in enumerate(raw):
+        key = f"arms[{i}]"
+        r.only(t, _ARMS_KEYS, ("arms", i), f"[[arms]] #{i + 1}")
+        arm_name = t.get("name", "")
+        if not isinstance(arm_name, str) or ("name" in t and not arm_name.strip()):
+            raise r.fail(f"{key}.name", "must be a non-empty string")
+        arm_name = arm_name.strip()
+        if arm_name and arm_name in names:
+            raise r.fail(f"{key}.name", f"{arm_name!r} names two arms (arms[{names.index(arm_name)}] "
+                         f"too)")
+        arm = _read_arm(r, t, key)
+        if arm.dof > MAX_LINKS_PER_ARM:
+            raise r.fail(f"{key}.links", f"at most {MAX_LINKS_PER_ARM} links per arm are "
+                         f"supported, got {arm.dof}")
+        for which, out in (("start_deg", start), ("goal_deg", goal)):
+            q_raw = r.required(t, which, f"{key}.{which}")
+            if isinstance(q_raw, list) and len(q_raw) != arm.dof:
+                raise r.fail(f"{key}.{which}", f"must have one angle per link ({arm.dof}), "
+                             f"got {len(q_raw)}")
+            out.extend(r.numbers(q_raw, f"{key}.{which}", length=arm.dof))
+        arms.append(arm)
+        names.append(arm_name)
+    return tuple(arms), (tuple(names) if any(names) else ()), tuple(start), tuple(goal)
+
+
+def _check_endpoints(s: Scenario, r: _Reader, arms_form: bool = False) -> None:
+    """Start and goal must be within the joint limits and collision-free (touching counts).
+
+    Each arm is checked against the obstacles on its own (so the message names the arm), then
+    the whole configuration with :func:`~xfuzzy_rrt.geometry.collision.clearance`, which also
+    counts contact between two arms.
+    """
+    from dataclasses import replace
+
     from xfuzzy_rrt.geometry.collision import clearance
 
     arrays = s.arrays()
+    slices = s.arm_slices()
     for which, q in (("start", s.start_deg), ("goal", s.goal_deg)):
-        for j, (angle, (lo, hi)) in enumerate(zip(q, s.arm.joint_limits_deg)):
-            if not lo <= angle <= hi:
-                raise r.fail(f"{which}.q_deg[{j}]",
-                             f"{angle:g} deg is outside the joint limits [{lo:g}, {hi:g}]")
-        c = clearance(arrays, np.asarray(q, dtype=np.float64))
-        if c <= 0.0:
-            raise r.fail(f"{which}.q_deg", f"configuration {list(q)} is in collision "
-                         f"(an arm link touches or overlaps an obstacle)")
+        q = tuple(q)
+        for a, (arm, sl) in enumerate(zip(s.arms, slices)):
+            key = f"arms[{a}].{which}_deg" if arms_form else f"{which}.q_deg"
+            for j, (angle, (lo, hi)) in enumerate(zip(q[sl], arm.joint_limits_deg)):
+                if not lo <= angle <= hi:
+                    raise r.fail(f"{key}[{j}]",
+                                 f"{angle:g} deg is outside the joint limits [{lo:g}, {hi:g}]")
+            alone = arrays if len(s.arms) == 1 else replace(
+                s, arm=arm, more_arms=(), arm_names=(), start_deg=q[sl], goal_deg=q[sl]).arrays()
+            if clearance(alone, np.asarray(q[sl], dtype=np.float64)) <= 0.0:
+                raise r.fail(key, f"configuration {list(q[sl])} is in collision "
+                             f"(an arm link touches or overlaps an obstacle)")
+        if len(s.arms) > 1 and clearance(arrays, np.asarray(q, dtype=np.float64)) <= 0.0:
+            raise r.fail(f"arms.{which}_deg", f"the arms touch or overlap each other at "
+                         f"{which} (arm-arm contact is a collision)")

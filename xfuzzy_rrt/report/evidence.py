@@ -50,19 +50,27 @@ def _describe_obstacle(o) -> str:
 
 
 def _scenario_details(s) -> str:
-    arm = s.arm
     deg = lambda q: "(" + ", ".join(f"{v:g}\u00b0" for v in q) + ")"  # noqa: E731
-    pairs = [
-        ("file", s.source or None),
-        ("description", s.description or None),
-        ("links", ", ".join(f"{v:g} m" for v in arm.links)),
-        ("base", f"({arm.base[0]:g}, {arm.base[1]:g}) m"),
-        ("link radius", f"{arm.link_radius:g} m"),
-        ("joint limits", ", ".join(f"[{lo:g}\u00b0, {hi:g}\u00b0]"
-                                   for lo, hi in arm.joint_limits_deg)),
-        ("start", deg(s.start_deg)),
-        ("goal", deg(s.goal_deg)),
-    ]
+    pairs = [("file", s.source or None), ("description", s.description or None)]
+    arms = getattr(s, "arms", (s.arm,))
+    for a, arm in enumerate(arms):
+        # one arm: the rows as always; several: each row names its arm ("arm 2 (right) links")
+        who = ""
+        if len(arms) > 1:
+            names = getattr(s, "arm_names", ())
+            who = f"arm {a + 1}" + (f" ({names[a]})" if a < len(names) and names[a] else "") + " "
+        pairs += [
+            (f"{who}links", ", ".join(f"{v:g} m" for v in arm.links)),
+            (f"{who}base", f"({arm.base[0]:g}, {arm.base[1]:g}) m"),
+            (f"{who}link radius", f"{arm.link_radius:g} m"),
+            (f"{who}joint limits", ", ".join(f"[{lo:g}\u00b0, {hi:g}\u00b0]"
+                                             for lo, hi in arm.joint_limits_deg)),
+        ]
+        if len(arms) > 1:
+            sl = s.arm_slices()[a]
+            pairs += [(f"{who}start", deg(s.start_deg[sl])), (f"{who}goal", deg(s.goal_deg[sl]))]
+    if len(arms) == 1:
+        pairs += [("start", deg(s.start_deg)), ("goal", deg(s.goal_deg))]
     pairs += [(f"obstacle {i + 1}", _describe_obstacle(o)) for i, o in enumerate(s.obstacles)]
     if not s.obstacles:
         pairs.append(("obstacles", "none"))

@@ -7,6 +7,11 @@ read the others. Each function takes the stable objects of the lower layers (``S
 ``PlanResult``, run/trace DataFrames) and returns a ``plotly.graph_objects.Figure``; none of
 them writes files or touches a planner's internals.
 
+Several arms (``scenario.arms``): the workspace draws every arm, each from its own slice of the
+configuration (``scenario.arm_slices()``), arm 1 solid, arm 2 dashed, arm 3 dotted, arm 4
+dash-dotted. The joint-space view plots two angles: for one 2-DOF arm over the C-obstacle map;
+otherwise the first two joints of the first arm, without a map, and the title says so.
+
 Conventions: joint angles in degrees, lengths in metres, equal axis scaling in both joint space
 and workspace (a 10 degree step looks like 10 degrees on both joints; circles look round), one
 colour per planner used everywhere (:data:`PLANNER_COLORS`, Okabe-Ito, colour-blind safe), and
@@ -127,9 +132,11 @@ def cspace_grid(scenario: Scenario, res_deg: float = 2.0) -> CSpaceGrid:
 
     Uses the planners' own ``clearance_kernel``, so the map shows exactly the obstacles the
     planners saw (not a re-implementation). A plain loop over the compiled kernel takes ~50 ms.
+    Only for one 2-DOF arm: the map is then the whole joint space.
     """
-    if scenario.arm.dof != 2:
-        raise ValueError(f"joint-space map needs a 2-DOF arm, got {scenario.arm.dof} joints")
+    if not has_cspace_map(scenario):
+        raise ValueError(f"joint-space map needs one 2-DOF arm, got {len(scenario.arms)} arm(s) "
+                         f"with {scenario.dof} joints")
     a = scenario.arrays()
     (lo1, hi1), (lo2, hi2) = a.limits_deg
     q1 = _axis(lo1, hi1, res_deg)
@@ -144,6 +151,20 @@ def cspace_grid(scenario: Scenario, res_deg: float = 2.0) -> CSpaceGrid:
                 q[0] = q1[i]
                 flags[j, i] = clearance_kernel(problem, q) <= 0.0
     return CSpaceGrid(q1_deg=q1, q2_deg=q2, collision=flags, res_deg=float(res_deg))
+
+
+def has_cspace_map(scenario: Scenario) -> bool:
+    """True when the joint space is a plane (one 2-DOF arm), so a C-obstacle map exists."""
+    return len(scenario.arms) == 1 and scenario.arm.dof == 2
+
+
+def joint_view_note(scenario: Scenario) -> str:
+    """What a joint-space figure of ``scenario`` shows beyond one 2-DOF arm ('' for one)."""
+    if has_cspace_map(scenario):
+        return ""
+    who = "arm 1" if len(scenario.arms) > 1 else "the arm"
+    return (f"first two joints of {who} ({scenario.dof} joints in all); no C-obstacle map "
+            "beyond one 2-DOF arm")
 
 
 def tree_edges(nodes_deg: np.ndarray, parent: np.ndarray, cols: tuple[int, int] = (0, 1)):
@@ -189,12 +210,18 @@ def joint_space_figure(scenario: Scenario, result=None, grid: CSpaceGrid | None 
     """C-obstacle map, the planner's tree (light), its path (bold), start and goal, in degrees.
 
     ``result`` is a ``PlanResult`` (or ``None`` to draw the scenario alone); ``grid`` may be a
-    precomputed :func:`cspace_grid` to share between planners. For arms with more than two
-    joints the map is omitted and the first two joints are drawn.
+    precomputed :func:`cspace_grid` to share between planners. Beyond one 2-DOF arm (more joints
+    or more arms) the map is omitted, the first two joints of the first arm are drawn and the
+    title says so (:func:`joint_view_note`).
     """
     fig = go.Figure()
     limits = np.asarray(scenario.arm.joint_limits_deg, dtype=np.float64).reshape(-1, 2)
-    if scenario.arm.dof == 2:
+    if limits.shape[0] < 2:  # a one-link arm: q2 is the next arm's first joint, or nothing
+        limits = np.asarray(scenario.joint_limits_deg, dtype=np.float64).reshape(-1, 2)
+        if limits.shape[0] < 2:
+            limits = np.vstack([limits, limits])
+    note = joint_view_note(scenario)
+    if has_cspace_map(scenario):
         grid = grid or cspace_grid(scenario)
         if grid.collision.any():
             fig.add_trace(go.Heatmap(
@@ -209,11 +236,13 @@ def joint_space_figure(scenario: Scenario, result=None, grid: CSpaceGrid | None 
                                  line=dict(color=_rgba(color, 0.35), width=1), hoverinfo="skip"))
     if result is not None and np.size(result.path_deg):
         p = np.asarray(result.path_deg, dtype=np.float64)
+        if p.shape[1] < 2:
+            p = np.hstack([p, np.zeros_like(p)])
         fig.add_trace(go.Scatter(
             x=p[:, 0], y=p[:, 1], mode="lines+markers", name="path",
             line=dict(color=color, width=3.5), marker=dict(size=4, color=color),
             hovertemplate="q1 %{x:.1f}\u00b0<br>q2 %{y:.1f}\u00b0<extra>path</extra>"))
-    s, g = scenario.start_deg, scenario.goal_deg
+    s, g = tuple(scenario.start_deg) + (0.0,), tuple(scenario.goal_deg) + (0.0,)
     fig.add_trace(go.Scatter(x=[s[0]], y=[s[1]], mode="markers", name="start",
                              marker=dict(symbol="circle", size=13, color=START_COLOR,
                                          line=dict(color="white", width=1.5)),
@@ -224,6 +253,12 @@ def joint_space_figure(scenario: Scenario, result=None, grid: CSpaceGrid | None 
                              hovertemplate="goal (%{x:.1f}\u00b0, %{y:.1f}\u00b0)<extra></extra>"))
     if title is None:
         title = _default_title(scenario, result, "joint space")
+        if note:
+            title += f"<br><sup>{plot_text(note)}</sup>"
+    elif note:  # a caller's title: the note goes above the plot
+        fig.add_annotation(text=plot_text(note), xref="paper", yref="paper", x=0.0, y=1.0,
+                           xanchor="left", yanchor="bottom", showarrow=False,
+                           font=dict(size=11, color="#555555"), name="joint-view-note")
     fig.update_layout(
         template=TEMPLATE, title=dict(text=title, x=0.5, xanchor="center"),
         margin=dict(l=55, r=15, t=70, b=50),
@@ -289,10 +324,13 @@ def _obstacle_shapes(obstacles) -> list[dict]:
 
 
 def workspace_bounds(scenario: Scenario, pad: float = 0.08) -> tuple[list[float], list[float]]:
-    """Axis ranges covering the reachable disc and every obstacle, padded by ``pad``."""
-    bx, by = scenario.arm.base
-    r = scenario.arm.reach + scenario.arm.link_radius
-    xs, ys = [bx - r, bx + r], [by - r, by + r]
+    """Axis ranges covering every arm's reachable disc and every obstacle, padded by ``pad``."""
+    xs, ys = [], []
+    for arm in scenario.arms:
+        bx, by = arm.base
+        r = arm.reach + arm.link_radius
+        xs += [bx - r, bx + r]
+        ys += [by - r, by + r]
     for o in scenario.obstacles:
         if isinstance(o, Circle):
             xs += [o.center[0] - o.radius, o.center[0] + o.radius]
@@ -305,13 +343,56 @@ def workspace_bounds(scenario: Scenario, pad: float = 0.08) -> tuple[list[float]
     return [min(xs) - m, max(xs) + m], [min(ys) - m, max(ys) + m]
 
 
+#: Line styles telling the arms apart (arm 1 solid, arm 2 dashed, ...).
+ARM_DASHES = ("solid", "dash", "dot", "dashdot")
+
+
+def arm_label(scenario: Scenario, a: int) -> str:
+    """``arm`` for a single arm; else the arm's ``[[arms]] name`` or ``arm 2``."""
+    if len(scenario.arms) == 1:
+        return "arm"
+    names = scenario.arm_names
+    return names[a] if a < len(names) and names[a] else f"arm {a + 1}"
+
+
+def arm_joint_points(scenario: Scenario, q) -> list[np.ndarray]:
+    """Each arm's base, joints and tip (``[dof_a + 1, 2]``) for the full configuration ``q``."""
+    q = np.asarray(q, dtype=np.float64)
+    return [joint_points(arm.links, arm.base, q[sl])
+            for arm, sl in zip(scenario.arms, scenario.arm_slices())]
+
+
+def _arm_traces(scenario: Scenario, q, name: str, color: str, width: float, showlegend: bool,
+                group: str, opacity: float = 1.0) -> list[go.Scatter]:
+    """One trace per arm for configuration ``q`` (see :func:`_arm_trace`); for several arms the
+    names say which arm (``left at start``) and the line style tells them apart."""
+    if len(scenario.arms) == 1:
+        return [_arm_trace(scenario, q, name, color, width, showlegend, group, opacity)]
+    out = []
+    q = np.asarray(q, dtype=np.float64)
+    for a, sl in enumerate(scenario.arm_slices()):
+        label = name.replace("arm", arm_label(scenario, a), 1) if "arm" in name \
+            else f"{arm_label(scenario, a)} {name}"
+        out.append(_arm_trace(scenario, q, label, color, width, showlegend, group, opacity,
+                              arm=a))
+    return out
+
+
 def _arm_trace(scenario: Scenario, q, name: str, color: str, width: float, showlegend: bool,
-               group: str, opacity: float = 1.0) -> go.Scatter:
-    pts = joint_points(scenario.arm.links, scenario.arm.base, q)
-    label = ", ".join(f"{v:.1f}\u00b0" for v in np.asarray(q, dtype=float))
+               group: str, opacity: float = 1.0, arm: int = 0) -> go.Scatter:
+    """Arm ``arm`` of ``scenario`` at configuration ``q`` (all arms' angles, or one arm's)."""
+    q = np.asarray(q, dtype=np.float64)
+    a = scenario.arms[arm]
+    if q.shape[0] == scenario.dof and len(scenario.arms) > 1:
+        q = q[scenario.arm_slices()[arm]]
+    pts = joint_points(a.links, a.base, q)
+    label = ", ".join(f"{v:.1f}\u00b0" for v in q)
+    line = dict(color=color, width=width)
+    if len(scenario.arms) > 1:
+        line["dash"] = ARM_DASHES[arm % len(ARM_DASHES)]
     return go.Scatter(x=pts[:, 0], y=pts[:, 1], mode="lines+markers", name=name,
                       legendgroup=group, showlegend=showlegend, opacity=opacity,
-                      line=dict(color=color, width=width),
+                      line=line,
                       marker=dict(size=[9] + [6] * (pts.shape[0] - 1), color=color,
                                   line=dict(color="white", width=1)),
                       hovertemplate=f"{plot_text(name)} q=({label})<br>"
@@ -327,11 +408,10 @@ def workspace_figure(scenario: Scenario, result=None, n_poses: int = 5,
     drawn (arm at start and goal).
     """
     fig = go.Figure()
-    bx, by = scenario.arm.base
-    reach = scenario.arm.reach
-    shapes = [dict(type="circle", xref="x", yref="y", x0=bx - reach, y0=by - reach,
-                   x1=bx + reach, y1=by + reach, layer="below",
-                   line=dict(color="#999999", width=1, dash="dot"))]
+    shapes = [dict(type="circle", xref="x", yref="y", x0=arm.base[0] - arm.reach,
+                   y0=arm.base[1] - arm.reach, x1=arm.base[0] + arm.reach,
+                   y1=arm.base[1] + arm.reach, layer="below",
+                   line=dict(color="#999999", width=1, dash="dot")) for arm in scenario.arms]
     shapes += _obstacle_shapes(scenario.obstacles)
     if scenario.obstacles:
         fig.add_trace(_legend_square("obstacle", OBSTACLE_FILL))
@@ -340,19 +420,28 @@ def workspace_figure(scenario: Scenario, result=None, n_poses: int = 5,
     if path.shape[0] >= 2:
         dense = interpolate_path(path, 1.0)
         for k, q in enumerate(_poses_along(dense, n_poses)):
-            fig.add_trace(_arm_trace(scenario, q, "arm along path", color, 4, k == 0, "poses",
-                                     opacity=0.35))
-        ee = np.array([joint_points(scenario.arm.links, scenario.arm.base, q)[-1]
-                       for q in dense])
-        fig.add_trace(go.Scatter(x=ee[:, 0], y=ee[:, 1], mode="lines",
-                                 name="end-effector trace", line=dict(color=color, width=2.5),
-                                 hovertemplate="x %{x:.3f} m, y %{y:.3f} m<extra>end effector"
-                                               "</extra>"))
-    fig.add_trace(_arm_trace(scenario, scenario.start_deg, "arm at start", START_COLOR, 5, True,
-                             "start"))
-    fig.add_trace(_arm_trace(scenario, scenario.goal_deg, "arm at goal", GOAL_COLOR, 5, True,
-                             "goal"))
-    fig.add_trace(go.Scatter(x=[bx], y=[by], mode="markers", name="base", showlegend=False,
+            fig.add_traces(_arm_traces(scenario, q, "arm along path", color, 4, k == 0, "poses",
+                                       opacity=0.35))
+        several = len(scenario.arms) > 1
+        for a, sl in enumerate(scenario.arm_slices()):
+            arm = scenario.arms[a]
+            ee = np.array([joint_points(arm.links, arm.base, q[sl])[-1] for q in dense])
+            line = dict(color=color, width=2.5)
+            name = "end-effector trace"
+            if several:
+                line["dash"] = ARM_DASHES[a % len(ARM_DASHES)]
+                name = f"{arm_label(scenario, a)} end-effector trace"
+            fig.add_trace(go.Scatter(x=ee[:, 0], y=ee[:, 1], mode="lines",
+                                     name=name, line=line,
+                                     hovertemplate="x %{x:.3f} m, y %{y:.3f} m<extra>end effector"
+                                                   "</extra>"))
+    fig.add_traces(_arm_traces(scenario, scenario.start_deg, "arm at start", START_COLOR, 5, True,
+                               "start"))
+    fig.add_traces(_arm_traces(scenario, scenario.goal_deg, "arm at goal", GOAL_COLOR, 5, True,
+                               "goal"))
+    bxs = [arm.base[0] for arm in scenario.arms]
+    bys = [arm.base[1] for arm in scenario.arms]
+    fig.add_trace(go.Scatter(x=bxs, y=bys, mode="markers", name="base", showlegend=False,
                              marker=dict(symbol="square", size=11, color="#222222"),
                              hovertemplate="base<extra></extra>"))
     if title is None:

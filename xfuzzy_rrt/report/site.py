@@ -332,8 +332,8 @@ def worst_path_figure(scenario, run):
         f"<b>{F.plot_text(F.planner_label(run.planner))}</b><br><sup>"
         f"{F.plot_text(scenario.name)}, seed {int(run.seed)}<br>closest approach {closest}"
         "</sup>"))
-    fig.add_trace(F._arm_trace(scenario, q, "closest configuration", "#d7191c", 5, True,
-                               "closest"))
+    fig.add_traces(F._arm_traces(scenario, q, "closest configuration", "#d7191c", 5, True,
+                                 "closest"))
     fig.update_layout(height=400, showlegend=False, margin=dict(l=50, r=10, t=80, b=40))
     return fig
 
@@ -353,7 +353,7 @@ def _certification(ctx, page: Page, t: pd.DataFrame) -> None:
     for p in ctx["planners"]:
         r = worst.get(p)
         s = result.scenarios.get(r.scenario) if r is not None else None
-        if r is None or s is None or s.arm.dof != 2 or np.size(r.path_deg) < 4:
+        if r is None or s is None or np.size(r.path_deg) < 2 * s.dof:
             cells.append(f'<div class="cell"><p class="muted">{esc(F.planner_label(p))}: no '
                          "stored worst path (no path found, or a bench folder written before "
                          "worst paths were stored)</p></div>")
@@ -507,12 +507,18 @@ def _scenario_page(ctx, idx: int, name: str) -> str:
         return page.render(plotly_src=PLOTLY_JS)
     page.add("<details><summary>Scenario definition</summary>" + _scenario_details(s)
              + "</details>")
-    grid = F.cspace_grid(s, res_deg=2.0) if s.arm.dof == 2 else None
+    grid = F.cspace_grid(s, res_deg=2.0) if F.has_cspace_map(s) else None
     page.heading("Paths and trees (the median-iteration run of each planner)", anchor="paths")
     page.paragraph("Joint space: grey cells are configurations in collision (2\u00b0 grid, the "
                    "planners' own checker); light lines the tree; bold the path. Workspace: "
                    "obstacles grey, the arm at start, goal and along the path, the end-effector "
                    "trace.")
+    if grid is None:
+        page.paragraph(f"This scenario has {len(s.arms)} arm(s) and {s.dof} joints in all: the "
+                       "joint-space view shows the first two joints of the first arm, without a "
+                       "C-obstacle map (which needs one 2-DOF arm). The workspace draws every "
+                       "arm from its own joint angles" + (" (arm 1 solid, arm 2 dashed, arm 3 "
+                       "dotted, arm 4 dash-dotted)." if len(s.arms) > 1 else "."))
     ran = set(runs["planner"])
     ncol = max(1, min(4, len(planners)))
     for kind in ("joint", "workspace"):

@@ -20,6 +20,16 @@ def _arm_points(links, base, q_deg):
     return np.array(pts)
 
 
+def _arms_points(arrays, q_deg):
+    """Every arm's points for the full configuration ``q_deg`` (each arm from its own slice)."""
+    q = np.asarray(q_deg, dtype=float)
+    first = getattr(arrays, "arm_first", None)
+    if first is None or len(first) <= 2:
+        return [_arm_points(arrays.links, arrays.base, q)]
+    return [_arm_points(arrays.links[first[k]:first[k + 1]], arrays.bases[k],
+                        q[first[k]:first[k + 1]]) for k in range(len(first) - 1)]
+
+
 def _obstacle_shapes(obstacles, colour, dash):
     shapes = []
     for ob in obstacles:
@@ -73,9 +83,12 @@ def robustness_page(items) -> str:
         a = pp.scenario.arrays()
         arm = go.Figure()
         for q in worst.worst_path_deg:
-            pts = _arm_points(a.links, a.base, q)
-            arm.add_trace(go.Scatter(x=pts[:, 0], y=pts[:, 1], mode="lines",
-                                     line=dict(color="rgba(30,90,200,0.35)"), showlegend=False))
+            for k, pts in enumerate(_arms_points(a, q)):
+                line = dict(color="rgba(30,90,200,0.35)")
+                if k:  # several arms: the second dashed, ...
+                    line["dash"] = ("dash", "dot", "dashdot")[(k - 1) % 3]
+                arm.add_trace(go.Scatter(x=pts[:, 0], y=pts[:, 1], mode="lines",
+                                         line=line, showlegend=False))
         arm.update_layout(
             shapes=_obstacle_shapes(a.obstacles, "grey", "dot")
             + _obstacle_shapes(worst.worst_obstacles, "crimson", "solid"),

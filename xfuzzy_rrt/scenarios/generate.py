@@ -21,6 +21,10 @@ straight-line length and the fraction of C-space in collision.
 
 The problems depend only on ``seed``: draw ``k`` uses ``numpy.random.default_rng([seed, k])``,
 so ``--count 24`` starts with the same problems as ``--count 8``.
+
+``--dof N`` (joints per arm) and ``--arms K`` select the N-DOF / multi-arm family instead
+(:func:`generate_nd`; docs/scenarios.md): no C-space grid there (the joint space is not a
+plane), so solvability is shown by a certified RRT path alone, recorded in the description.
 """
 
 from __future__ import annotations
@@ -31,8 +35,9 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, clearance_kernel
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, clearance, clearance_kernel
 from xfuzzy_rrt.geometry.scenario import Arm, Box, Circle, Scenario
+from xfuzzy_rrt.scenarios.writer import scenario_toml  # noqa: F401  (re-exported)
 
 GRID_DEG = 2.0
 RRT_BUDGET = 20_000
@@ -43,9 +48,12 @@ MAX_DRAWS_PER_PROBLEM = 200
 class GeneratedProblem:
     scenario: Scenario
     text: str  # the TOML file
-    grid_optimal_deg: float
+    grid_optimal_deg: float  # nan beyond one 2-DOF arm (no grid over the joint space)
     straight_deg: float
-    c_obstacle_fraction: float
+    c_obstacle_fraction: float  # nan beyond one 2-DOF arm
+    #: For the N-DOF and multi-arm family: the RRT run that proved the problem solvable.
+    solved_iterations: int | None = None
+    solved_seed: int | None = None
 
 
 #: Problem families: the shared ``sample-*`` family and two harder ones that cover what users
@@ -149,7 +157,12 @@ def _free_grid(P, angles, margin):
 
 
 def c_space_grid(scenario: Scenario, step_deg: float = GRID_DEG) -> tuple[np.ndarray, np.ndarray]:
-    """``(angles, free)``: grid angles and a boolean [n, n] map of free configurations."""
+    """``(angles, free)``: grid angles and a boolean [n, n] map of free configurations.
+
+    Only for a single 2-DOF arm (the map is then the whole joint space).
+    """
+    if len(scenario.arms) != 1 or scenario.arm.dof != 2:
+        raise ValueError("the C-space grid needs one 2-DOF arm")
     a = scenario.arrays()
     angles = np.arange(-180.0, 180.0 + 1e-9, step_deg)
     return angles, _free_grid(a.problem(CERT_MARGIN_M), angles, CERT_MARGIN_M)
@@ -188,38 +201,30 @@ def grid_optimal_deg(scenario: Scenario, step_deg: float = GRID_DEG,
     return float(dist + np.linalg.norm(s_q - scenario.start_deg) + np.linalg.norm(g_q - scenario.goal_deg))
 
 
-def scenario_toml(s: Scenario, description: str) -> str:
-    """The TOML text of a generated scenario (the shared format, see FORMAT.md)."""
-    def num(x: float) -> str:
-        return repr(float(x))
-
-    lines = [f'name = "{s.name}"', f'description = "{description}"', "", "[arm]",
-             f"links = [{', '.join(num(v) for v in s.arm.links)}]",
-             f"link_radius = {num(s.arm.link_radius)}", "", "[start]",
-             f"q_deg = [{num(s.start_deg[0])}, {num(s.start_deg[1])}]", "", "[goal]",
-             f"q_deg = [{num(s.goal_deg[0])}, {num(s.goal_deg[1])}]"]
-    for o in s.obstacles:
-        lines += ["", "[[obstacles]]"]
-        if isinstance(o, Circle):
-            lines += ['type = "circle"', f"center = [{num(o.center[0])}, {num(o.center[1])}]",
-                      f"radius = {num(o.radius)}"]
-        else:
-            lines += ['type = "box"', f"min = [{num(o.min[0])}, {num(o.min[1])}]",
-                      f"max = [{num(o.max[0])}, {num(o.max[1])}]"]
-    return "\n".join(lines) + "\n"
+def _config_ok(a, q) -> bool:
+    """Within the joint limits and farther than the planners' margin from every obstacle."""
+    q = np.asarray(q, dtype=np.float64)
+    lim = a.limits_deg
+    if np.any(q < lim[:, 0]) or np.any(q > lim[:, 1]):
+        return False
+    return clearance(a, q) > CERT_MARGIN_M
 
 
-def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample") -> GeneratedProblem:
+def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample",
+                 dof: int = 2, arms: int = 1) -> GeneratedProblem:
     """Problem ``k`` of generator ``seed`` in *family* (draws until one passes every check).
 
     The ``sample`` family draws from ``default_rng([seed, k])`` (as it always has); the other
     families from ``default_rng([seed, k, i])`` with ``i`` their index in :data:`FAMILIES`, so
-    no two families share a stream.
+    no two families share a stream. ``dof`` (joints per arm) other than 2 or ``arms`` other than
+    1 selects the N-DOF / multi-arm family (:func:`generate_nd`); ``family`` is then ignored.
     """
+    if dof != 2 or arms != 1:
+        return generate_nd(seed, k, prefix, dof, arms)
     if family not in FAMILIES:
         raise ValueError(f"unknown family {family!r} (known: {', '.join(FAMILIES)})")
     from xfuzzy_rrt.errors import ScenarioError
-    from xfuzzy_rrt.geometry.collision import config_free, segment_free
+    from xfuzzy_rrt.geometry.collision import segment_free
     from xfuzzy_rrt.geometry.scenario import scenario_from_dict
     from xfuzzy_rrt.planners.rrt import plan_rrt
 
@@ -237,9 +242,7 @@ def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample")
         a = s.arrays()
         if segment_free(a, a.start_deg, a.goal_deg):
             continue  # trivial: the straight segment is free
-        problem = a.problem(CERT_MARGIN_M)
-        if not (config_free(problem, a.start_deg, CERT_MARGIN_M)
-                and config_free(problem, a.goal_deg, CERT_MARGIN_M)):
+        if not (_config_ok(a, a.start_deg) and _config_ok(a, a.goal_deg)):
             continue  # free, but closer than the planners' margin
         if not plan_rrt(s, seed=0, max_iter=RRT_BUDGET).success:
             continue  # not shown solvable
@@ -265,3 +268,152 @@ def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample")
 def generate(count: int, seed: int, prefix: str = "gen", family: str = "sample") -> list[GeneratedProblem]:
     """``count`` valid, solvable, non-trivial problems, determined by ``seed`` and *family*."""
     return [generate_one(seed, k, prefix, family) for k in range(count)]
+
+
+# --------------------------------------------------------------------------------------------
+# N-DOF and multi-arm problems (issue 17)
+# --------------------------------------------------------------------------------------------
+
+MIN_DOF, MAX_DOF = 2, 7
+MIN_ARMS, MAX_ARMS = 1, 4
+#: RRT budget and seeds of the solvability proof beyond one 2-DOF arm.
+ND_RRT_BUDGET = 30_000
+ND_RRT_SEEDS = (0, 1, 2)
+
+
+def nd_prefix(dof: int, arms: int) -> str:
+    """Default file-name prefix: ``dof5`` for one 5-DOF arm, ``arms2-dof3`` for two 3-DOF arms."""
+    return f"dof{dof}" if arms == 1 else f"arms{arms}-dof{dof}"
+
+
+def _chain_links(rng: np.random.Generator, dof: int, reach: float) -> tuple[float, ...]:
+    """``dof`` link lengths summing to about ``reach``, longer near the base (like the samples)."""
+    w = rng.uniform(0.7, 1.3, size=dof) * np.linspace(1.0, 0.6, dof)
+    w = w / w.sum() * reach
+    return tuple(round(max(float(v), 0.02), 3) for v in w)
+
+
+def _random_obstacle(rng: np.random.Generator, cx: float, cy: float, scale: float):
+    """A circle (70 %) or an axis-aligned box about ``(cx, cy)``; sizes scale with ``scale``."""
+    if rng.random() < 0.7:
+        return Circle(center=(round(cx, 4), round(cy, 4)),
+                      radius=round(float(rng.uniform(0.02, 0.06) * scale), 4))
+    w, h = rng.uniform(0.03, 0.08, size=2) * scale
+    return _box(cx, cy, float(w), float(h))
+
+
+def _draw_nd(rng: np.random.Generator, name: str, dof: int, arms: int) -> Scenario:
+    """One draft of the N-DOF / multi-arm family (see :func:`generate_nd`)."""
+    if arms == 1:
+        reach = float(rng.uniform(0.23, 0.35))  # the sample family's l1 + l2
+        arm = Arm(links=_chain_links(rng, dof, reach), link_radius=0.005,
+                  joint_limits_deg=((-180.0, 180.0),) * dof)
+        start = [float(rng.integers(-170, 171))] + rng.integers(-120, 121, dof - 1).astype(float).tolist()
+        goal = [float(rng.integers(-170, 171))] + rng.integers(-120, 121, dof - 1).astype(float).tolist()
+        obstacles = []
+        for _ in range(int(rng.integers(3, 8))):
+            r = rng.uniform(0.4, 1.1) * reach
+            a = rng.uniform(0.0, 2.0 * math.pi)
+            obstacles.append(_random_obstacle(rng, r * math.cos(a), r * math.sin(a), 1.0))
+        return Scenario(name=name, arm=arm, start_deg=tuple(start), goal_deg=tuple(goal),
+                        obstacles=tuple(obstacles))
+    # Several arms side by side on the x axis, gap apart, all facing +y: the workspaces overlap
+    # (each reach exceeds half the gap), so the arms can touch each other.
+    gap = float(rng.uniform(0.25, 0.40))
+    arm_list, start, goal = [], [], []
+    for i in range(arms):
+        reach = float(rng.uniform(0.22, 0.32))
+        base = (round((i - (arms - 1) / 2) * gap, 4), 0.0)
+        arm_list.append(Arm(links=_chain_links(rng, dof, reach), base=base, link_radius=0.005,
+                            joint_limits_deg=((-180.0, 180.0),) * dof))
+        for out in (start, goal):
+            out.append(float(rng.integers(20, 161)))
+            out.extend(rng.integers(-120, 121, dof - 1).astype(float).tolist())
+    obstacles = []
+    for _ in range(int(rng.integers(3, 8))):
+        host = arm_list[int(rng.integers(0, arms))]
+        r = rng.uniform(0.45, 1.0) * host.reach
+        a = rng.uniform(math.radians(20.0), math.radians(160.0))
+        obstacles.append(_random_obstacle(rng, host.base[0] + r * math.cos(a),
+                                          host.base[1] + r * math.sin(a), 0.7))
+    names = tuple(("left", "right")[i] if arms == 2 else f"arm{i + 1}" for i in range(arms))
+    return Scenario(name=name, arm=arm_list[0], more_arms=tuple(arm_list[1:]), arm_names=names,
+                    start_deg=tuple(start), goal_deg=tuple(goal), obstacles=tuple(obstacles))
+
+
+def _rrt_proof(s: Scenario):
+    """``(seed, iterations)`` of the first certified RRT path among :data:`ND_RRT_SEEDS`, or None."""
+    from xfuzzy_rrt.planners.api import plan_scenario
+
+    for plan_seed in ND_RRT_SEEDS:
+        result = plan_scenario(s, "rrt", seed=plan_seed, max_iter=ND_RRT_BUDGET)
+        if result.success:
+            return plan_seed, int(result.iterations)
+    return None
+
+
+def check_nd_arguments(dof: int, arms: int) -> None:
+    """Refuse a joint count or arm count outside the supported ranges (``ValueError``)."""
+    if not MIN_DOF <= dof <= MAX_DOF:
+        raise ValueError(f"--dof: must be {MIN_DOF} to {MAX_DOF} joints per arm, got {dof}")
+    if not MIN_ARMS <= arms <= MAX_ARMS:
+        raise ValueError(f"--arms: must be {MIN_ARMS} to {MAX_ARMS}, got {arms}")
+
+
+def generate_nd(seed: int, k: int, prefix: str | None = None, dof: int = 3,
+                arms: int = 1) -> GeneratedProblem:
+    """Problem ``k`` of generator ``seed`` with ``arms`` arms of ``dof`` joints each.
+
+    The family: each arm has ``dof`` links summing to 0.23–0.35 m (one arm; the reach of the
+    2-DOF sample family) or 0.22–0.32 m (several arms), longer near the base, 5 mm capsules,
+    joint limits ±180°. One arm sits at the origin among 3–7 obstacles (70 % circles of 2–6 cm
+    radius, else boxes of 3–8 cm sides) 0.4–1.1 reach from the base. Several arms stand on the x
+    axis 0.25–0.40 m apart, all facing +y, with 3–7 smaller obstacles (0.7×) in front of them:
+    each reach exceeds half the gap, so the arms can touch each other and must take turns.
+    Start and goal are whole degrees (joint 1 in [-170°, 170°], or [20°, 160°] facing the shared
+    workspace; the others in [-120°, 120°]).
+
+    Kept only when valid (the loader accepts it; start and goal clear by the planners' margin,
+    arm-arm contact included), non-trivial (the straight joint segment is not certified free)
+    and solvable: plain RRT (:func:`~xfuzzy_rrt.planners.api.plan_scenario`) returns a
+    certified path for one of seeds :data:`ND_RRT_SEEDS` within :data:`ND_RRT_BUDGET`
+    iterations; the description records which. Draws come from
+    ``default_rng([seed, k, 1000 * arms + dof])``, a stream no 2-DOF family uses.
+    """
+    import tomllib
+
+    from xfuzzy_rrt.errors import ScenarioError
+    from xfuzzy_rrt.geometry.collision import segment_free
+    from xfuzzy_rrt.geometry.scenario import scenario_from_dict
+
+    check_nd_arguments(dof, arms)
+    prefix = nd_prefix(dof, arms) if prefix is None else prefix
+    rng = np.random.default_rng([int(seed), int(k), 1000 * int(arms) + int(dof)])
+    name = f"{prefix}-{seed}-{k:03d}"
+    what = f"one {dof}-DOF arm" if arms == 1 else f"{arms} arms of {dof} joints"
+    for _ in range(MAX_DRAWS_PER_PROBLEM):
+        draft = _draw_nd(rng, name, dof, arms)
+        try:
+            s = scenario_from_dict(tomllib.loads(scenario_toml(draft, "draft")), name)
+        except ScenarioError:
+            continue  # start or goal in collision
+        a = s.arrays()
+        if not (_config_ok(a, a.start_deg) and _config_ok(a, a.goal_deg)):
+            continue  # free, but closer than the planners' margin
+        if segment_free(a, a.start_deg, a.goal_deg):
+            continue  # trivial: the straight segment is free
+        proof = _rrt_proof(s)
+        if proof is None:
+            continue  # not shown solvable
+        plan_seed, iterations = proof
+        straight = float(np.linalg.norm(a.goal_deg - a.start_deg))
+        desc = (f"generated (xfuzzy-rrt scenarios generate, seed {seed}, problem {k}, {what}); "
+                f"straight {straight:.1f} deg, blocked; rrt solved it in {iterations} iterations "
+                f"(seed {plan_seed})")
+        text = scenario_toml(s, desc)
+        final = scenario_from_dict(tomllib.loads(text), name)
+        return GeneratedProblem(scenario=final, text=text, grid_optimal_deg=math.nan,
+                                straight_deg=straight, c_obstacle_fraction=math.nan,
+                                solved_iterations=iterations, solved_seed=plan_seed)
+    raise RuntimeError(f"no valid problem after {MAX_DRAWS_PER_PROBLEM} draws (seed {seed}, k {k}, "
+                       f"{what})")

@@ -65,7 +65,7 @@ def load_result_path(scenario, result_file: Path) -> PlannedPath:
     if name is not None and name != scenario.name:
         raise InputError(where, f"scenario: this result was planned in {name!r}, not in "
                          f"{scenario.name!r} ({scenario.source or 'the scenario given'})")
-    path = _path_array(data["path_deg"], scenario.arm.dof, where)
+    path = _path_array(data["path_deg"], scenario.dof, where)
     return PlannedPath(scenario, str(data.get("planner", "?")), int(data.get("seed", 0) or 0),
                        path, where)
 
@@ -96,7 +96,7 @@ def load_bench_paths(folder: Path) -> list[PlannedPath]:
         if s is None or not e.get("path_deg"):
             continue
         out.append(PlannedPath(s, str(e.get("planner")), int(e.get("seed", 0) or 0),
-                               _path_array(e["path_deg"], s.arm.dof, str(folder / "examples")),
+                               _path_array(e["path_deg"], s.dof, str(folder / "examples")),
                                str(folder)))
     if not out:
         raise InputError(str(folder), "no example path to analyse (examples/index.json)")

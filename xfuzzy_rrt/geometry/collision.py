@@ -289,6 +289,12 @@ def edge_free(P, qa_deg, qb_deg, margin):
     if not clear > 0.0:
         clear = 0.0
     seg = np.empty((P.links.shape[0] if n_arms > 1 else 0, 4))
+    # The motion bounds depend only on the segment: computed once, not at every stop.
+    mks = np.empty(P.links.shape[0])
+    for a in range(n_arms):
+        first = P.arm_first[a]
+        for k in range(first, P.arm_first[a + 1]):
+            mks[k] = link_motion_bound(P.links, qa_deg, qb_deg, k, first)
     s = 0.0
     while True:
         # Per-link clearance at q(s) and the safe advance it buys.
@@ -298,8 +304,7 @@ def edge_free(P, qa_deg, qb_deg, margin):
             x = P.bases[a, 0]
             y = P.bases[a, 1]
             theta = 0.0
-            first = P.arm_first[a]
-            for k in range(first, P.arm_first[a + 1]):
+            for k in range(P.arm_first[a], P.arm_first[a + 1]):
                 qk = qa_deg[k] + s * (qb_deg[k] - qa_deg[k])
                 if s >= 1.0:
                     qk = qb_deg[k]
@@ -318,7 +323,7 @@ def edge_free(P, qa_deg, qb_deg, margin):
                         return False
                     if ck < cmin:
                         cmin = ck
-                    mk = link_motion_bound(P.links, qa_deg, qb_deg, k, first)
+                    mk = mks[k]
                     if mk > 0.0:
                         step = (ck - clear) / mk
                         if step < ds:
@@ -327,13 +332,11 @@ def edge_free(P, qa_deg, qb_deg, margin):
                 y = ny
         if n_arms > 1:
             for a in range(n_arms):
-                fa = P.arm_first[a]
                 for b in range(a + 1, n_arms):
-                    fb = P.arm_first[b]
                     rr = P.radii[a] + P.radii[b]
-                    for k in range(fa, P.arm_first[a + 1]):
-                        mka = link_motion_bound(P.links, qa_deg, qb_deg, k, fa)
-                        for m in range(fb, P.arm_first[b + 1]):
+                    for k in range(P.arm_first[a], P.arm_first[a + 1]):
+                        mka = mks[k]
+                        for m in range(P.arm_first[b], P.arm_first[b + 1]):
                             d = segment_segment_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
                                                      seg[m, 0], seg[m, 1], seg[m, 2],
                                                      seg[m, 3]) - rr
@@ -341,7 +344,7 @@ def edge_free(P, qa_deg, qb_deg, margin):
                                 return False
                             if d < cmin:
                                 cmin = d
-                            mkm = mka + link_motion_bound(P.links, qa_deg, qb_deg, m, fb)
+                            mkm = mka + mks[m]
                             if mkm > 0.0:
                                 step = (d - clear) / mkm
                                 if step < ds:

@@ -69,7 +69,7 @@ from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
-from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest
+from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
 MIN_STEP_DEG = 0.5
@@ -271,6 +271,11 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     tree = make_tree(int(max_iter) + 2, a.limits_deg)
     groups = fis_groups(rb, scenario)
     buffers = make_trace(int(max_iter) if trace else 1, a.dof, knots.shape[0], groups)
+    if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
+        meta0 = tree.meta.copy()
+        kernel(problem, tree, int(seed), 0, knots, consts, mode, float(min_step_deg),
+               np.zeros(1, dtype=np.int64), bool(trace), buffers)
+        reset_tree(tree, meta0)
     with StopFlag(max_time_s) as flag:
         t0 = time.perf_counter()
         ok, iterations, last = kernel(problem, tree, int(seed), int(max_iter), knots, consts,

@@ -24,7 +24,7 @@ from xfuzzy_rrt.planners.params import resolve_params
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
-from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest
+from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
 
 DEFAULT_STEP_DEG = 10.0
 DEFAULT_GOAL_BIAS = 0.05
@@ -77,11 +77,15 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
     a = scenario.arrays()
     problem = a.problem(margin)
     tree = make_tree(int(max_iter) + 2, a.limits_deg)
+    args = (float(params["step_deg"]), float(params["goal_bias"]))
+    if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
+        meta0 = tree.meta.copy()
+        rrt_kernel(problem, tree, int(seed), 0, *args, np.zeros(1, dtype=np.int64))
+        reset_tree(tree, meta0)
     with StopFlag(max_time_s) as flag:
         t0 = time.perf_counter()
-        ok, iterations, last = rrt_kernel(problem, tree, int(seed), int(max_iter),
-                                          float(params["step_deg"]),
-                                          float(params["goal_bias"]), flag.array)
+        ok, iterations, last = rrt_kernel(problem, tree, int(seed), int(max_iter), *args,
+                                          flag.array)
         wall = time.perf_counter() - t0
     n = int(tree.meta[0])
     path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, a.dof))

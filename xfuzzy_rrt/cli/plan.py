@@ -31,6 +31,8 @@ def plan(
     goal_bias: float = typer.Option(0.05, "--goal-bias", help="RRT goal bias in [0, 1]."),
     clearance: Optional[float] = typer.Option(
         None, "--clearance", help="Certified clearance in metres every link keeps from every obstacle (default: the scenario's [safety] clearance_m, else 0)."),
+    max_time: Optional[float] = typer.Option(
+        None, "--max-time", help="Wall-clock budget in seconds on top of --max-iter (whichever ends first; the result's params say which)."),
 ) -> int:
     """Plan a path from the scenario's start to its goal.
 
@@ -39,6 +41,7 @@ def plan(
     """
     from xfuzzy_rrt.cli.common import check_output_file, emit_json, load_scenario_warn
     from xfuzzy_rrt.planners.api import parse_planner, plan_scenario, write_trace_checked
+    from xfuzzy_rrt.planners.termination import check_max_time
 
     spec = parse_planner(planner, "--planner")
     if trace is not None:
@@ -60,6 +63,7 @@ def plan(
     result = plan_scenario(
         s, planner=planner, rulebook=rulebook_obj, seed=seed, max_iter=max_iter,
         step_deg=step_deg, goal_bias=goal_bias, trace=trace is not None, clearance_m=clearance,
+        max_time_s=None if max_time is None else check_max_time(max_time),
     )
     if trace is not None:
         from xfuzzy_rrt.planners.api import write_trace

@@ -2,19 +2,22 @@
 
 Nodes live in preallocated arrays (``nodes[cap, dof]`` in degrees, ``parent[cap]``), so the
 compiled planner loop never allocates. Nearest-neighbour search is *exact* (the brute-force
-answer, ties to the lowest node index) and must not make long runs quadratic. It uses a
-uniform grid over the first two joints with one linked list per cell, searched in Chebyshev
-rings around the query's cell and only within the bounding box of occupied cells. A ring search
-stops once the best distance found is strictly below the smallest distance any unvisited ring
-could hold. That ring distance is measured in the first two joints only, which is a lower bound
-of the distance over all joints, so the stop is exact in any dimension; with two joints it is
-the whole distance and the cost per query stays roughly constant as the tree grows to 10,000
-nodes. With more joints the search visits more rings (nearest neighbours are farther apart in
-more dimensions) but stays far below a linear scan (benchmarks/test_bench_tree.py).
+answer, ties to the lowest node index) and must not make long runs quadratic.
 
-Why not a k-d tree: an incremental k-d tree degenerates into a chain when nodes arrive in a
-spatially correlated order, which is exactly how an RRT grows (measured: slower than brute force
-at 5,000 nodes); a grid cannot degenerate.
+- **Two joints: a uniform grid** with one linked list per cell, searched in Chebyshev rings
+  around the query's cell and only within the bounding box of occupied cells. A ring search
+  stops once the best distance found is strictly below the smallest distance any unvisited ring
+  could hold, so the cost per query stays roughly constant as the tree grows to 10,000 nodes.
+- **Three joints and more: a balanced k-d tree plus a small buffer.** The nodes added since the
+  last build sit in a buffer scanned linearly; when it outgrows ``max(32, 2 sqrt(n))`` the
+  k-d tree is rebuilt over all nodes by median splits (quickselect, split axis = depth mod N),
+  so it is balanced whatever order the nodes came in. An *incremental* k-d tree was measured
+  slower than a linear scan: an RRT adds nodes in a spatially correlated order and the tree
+  degenerates into a chain. A query descends the k-d tree depth first and visits the far side of
+  a split only when the split plane is not farther than the best distance found (``<=``: equal
+  distances must be seen for the lowest-index tie rule), then scans the buffer. Rebuilds cost
+  ``O(n log n)`` about ``sqrt(n) / 2`` times per run; a query costs the tree search plus at most
+  ``2 sqrt(n)`` distances.
 
 The arrays travel together as one :class:`TreeArrays` record (a numba named tuple). Integer
 grid bookkeeping is ``meta = [n_nodes, ncx, ncy, bx0, by0, bx1, by1]`` (grid size and occupied
@@ -44,6 +47,18 @@ class TreeArrays(NamedTuple):
     cell_head: np.ndarray
     meta: np.ndarray
     grid: np.ndarray
+    #: k-d tree (3+ joints): node indices in tree order (the subtree of range ``[lo, hi)`` has
+    #: its root at ``(lo + hi) // 2``), each position's split axis, and the search stack.
+    kd_perm: np.ndarray
+    kd_axis: np.ndarray
+    kd_stack: np.ndarray
+    kd_stack_lb: np.ndarray
+
+
+#: ``meta`` slot holding how many nodes the k-d tree covers (the rest are in the buffer).
+KD_N = 7
+#: Entries of the k-d search stack: two per level of a balanced tree of 10^6 nodes, and more.
+KD_STACK = 128
 
 
 def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG) -> TreeArrays:
@@ -54,11 +69,14 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
     dof = limits_deg.shape[0]
     ncx = max(1, int(math.ceil((limits_deg[0, 1] - limits_deg[0, 0]) / cell_deg)))
     ncy = max(1, int(math.ceil((limits_deg[1, 1] - limits_deg[1, 0]) / cell_deg)))
+    kd = capacity if dof > 2 else 1
     return TreeArrays(
         np.zeros((capacity, dof), dtype=np.float64), np.full(capacity, -1, dtype=np.int64),
         np.full(capacity, -1, dtype=np.int64), np.full(ncx * ncy, -1, dtype=np.int64),
-        np.array([0, ncx, ncy, ncx, ncy, -1, -1], dtype=np.int64),
-        np.array([limits_deg[0, 0], limits_deg[1, 0], cell_deg], dtype=np.float64))
+        np.array([0, ncx, ncy, ncx, ncy, -1, -1, 0], dtype=np.int64),
+        np.array([limits_deg[0, 0], limits_deg[1, 0], cell_deg], dtype=np.float64),
+        np.zeros(kd, dtype=np.int64), np.zeros(kd, dtype=np.int64),
+        np.zeros((KD_STACK, 2), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64))
 
 
 #: Old name, kept for callers that build a tree by hand.
@@ -166,21 +184,143 @@ def _d2(nodes, i, q):
 
 
 @nb.njit(cache=True, nogil=True)
+def _select(nodes, perm, lo, hi, k, axis):
+    """Reorder ``perm[lo:hi]`` so that position ``k`` holds the node of rank ``k - lo`` along
+    ``axis``, smaller-or-equal ones before it and greater-or-equal ones after (quickselect,
+    middle pivot: deterministic)."""
+    while hi - lo > 1:
+        pivot = nodes[perm[(lo + hi) // 2], axis]
+        i = lo
+        j = hi - 1
+        while i <= j:
+            while nodes[perm[i], axis] < pivot:
+                i += 1
+            while nodes[perm[j], axis] > pivot:
+                j -= 1
+            if i <= j:
+                t = perm[i]
+                perm[i] = perm[j]
+                perm[j] = t
+                i += 1
+                j -= 1
+        if k <= j:
+            hi = j + 1
+        elif k >= i:
+            lo = i
+        else:
+            return
+
+
+@nb.njit(cache=True, nogil=True)
+def _kd_build(T, n):
+    """Balanced k-d tree over nodes ``0 .. n-1`` (median splits, axis = depth mod dof)."""
+    dof = T.nodes.shape[1]
+    for i in range(n):
+        T.kd_perm[i] = i
+    stack = T.kd_stack
+    depth = T.kd_axis  # reused below: written as each range's root is placed
+    top = 0
+    stack[0, 0] = 0
+    stack[0, 1] = n
+    T.kd_stack_lb[0] = 0.0  # the depth of the range, stored as a float
+    top = 1
+    while top > 0:
+        top -= 1
+        lo = stack[top, 0]
+        hi = stack[top, 1]
+        d = int(T.kd_stack_lb[top])
+        if hi - lo <= 0:
+            continue
+        mid = (lo + hi) // 2
+        axis = d % dof
+        _select(T.nodes, T.kd_perm, lo, hi, mid, axis)
+        depth[mid] = axis
+        if mid + 1 < hi:
+            stack[top, 0] = mid + 1
+            stack[top, 1] = hi
+            T.kd_stack_lb[top] = d + 1
+            top += 1
+        if lo < mid:
+            stack[top, 0] = lo
+            stack[top, 1] = mid
+            T.kd_stack_lb[top] = d + 1
+            top += 1
+    T.meta[KD_N] = n
+
+
+@nb.njit(cache=True, nogil=True)
+def _kd_nearest(T, q):
+    """Exact nearest node: k-d tree search, then the buffer (lowest index on ties)."""
+    nodes = T.nodes
+    best_d2 = np.inf
+    best_i = -1
+    n_kd = T.meta[KD_N]
+    stack = T.kd_stack
+    lbs = T.kd_stack_lb
+    top = 0
+    if n_kd > 0:
+        stack[0, 0] = 0
+        stack[0, 1] = n_kd
+        lbs[0] = 0.0
+        top = 1
+    while top > 0:
+        top -= 1
+        lo = stack[top, 0]
+        hi = stack[top, 1]
+        lb = lbs[top]
+        while lo < hi and lb <= best_d2:
+            mid = (lo + hi) // 2
+            i = T.kd_perm[mid]
+            d2 = _d2(nodes, i, q)
+            if d2 < best_d2 or (d2 == best_d2 and i < best_i):
+                best_d2 = d2
+                best_i = i
+            axis = T.kd_axis[mid]
+            diff = q[axis] - nodes[i, axis]
+            far_lb = max(lb, diff * diff)
+            if diff < 0.0:  # near side: the left range [lo, mid); far: (mid, hi)
+                if mid + 1 < hi and far_lb <= best_d2:
+                    stack[top, 0] = mid + 1
+                    stack[top, 1] = hi
+                    lbs[top] = far_lb
+                    top += 1
+                hi = mid
+            else:
+                if lo < mid and far_lb <= best_d2:
+                    stack[top, 0] = lo
+                    stack[top, 1] = mid
+                    lbs[top] = far_lb
+                    top += 1
+                lo = mid + 1
+    for i in range(n_kd, T.meta[N_NODES]):
+        d2 = _d2(nodes, i, q)
+        if d2 < best_d2 or (d2 == best_d2 and i < best_i):
+            best_d2 = d2
+            best_i = i
+    return best_i
+
+
+@nb.njit(cache=True, nogil=True)
 def add_node(T, q, parent_index):
     """Append configuration ``q`` with its parent; return its index."""
     i = T.meta[N_NODES]
     for j in range(q.shape[0]):
         T.nodes[i, j] = q[j]
     T.parent[i] = parent_index
-    _grid_add(T.cell_next, T.cell_head, T.meta, T.grid, i, q[0], q[1])
     T.meta[N_NODES] = i + 1
+    if T.nodes.shape[1] == 2:
+        _grid_add(T.cell_next, T.cell_head, T.meta, T.grid, i, q[0], q[1])
+    elif (i + 1 - T.meta[KD_N]) > max(32.0, 2.0 * math.sqrt(i + 1.0)):
+        _kd_build(T, i + 1)
     return i
 
 
 @nb.njit(cache=True, nogil=True)
 def nearest(T, q):
     """Index of the node nearest to ``q`` (Euclidean, degrees); lowest index on ties."""
-    return _grid_nearest(T.nodes, T.cell_next, T.cell_head, T.meta, T.grid, q)
+    if T.nodes.shape[1] == 2:
+        return _grid_nearest(T.nodes, T.cell_next, T.cell_head, T.meta, T.grid, q)
+    return _kd_nearest(T, q)
 
 
 @nb.njit(cache=True, nogil=True)

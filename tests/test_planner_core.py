@@ -155,3 +155,14 @@ def _shipped(name):
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached, rulebooks_dir
 
     return load_rulebook_cached(rulebooks_dir() / name)
+
+
+def test_explain_shows_each_arm_of_a_dual_arm_trace(run_cli, tmp_path):
+    trace = tmp_path / "t.csv"
+    proc = run_cli("plan", str(ARMS / "dual-2dof.toml"), "--planner", "fuzzy-rrt:expert",
+                   "--trace", str(trace), "--out", str(tmp_path / "p.json"))
+    assert proc.returncode == 0, proc.stderr
+    out = run_cli("explain", str(trace), "--iteration", "2")
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.count("### arm ") == 2 and "### arm 2 of 2" in out.stdout
+    assert out.stdout.count("== bound_4 ==") == 2

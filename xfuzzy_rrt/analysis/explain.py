@@ -15,6 +15,8 @@ compiled engine, the trace and the rulebook text would show up here.
 
 from __future__ import annotations
 
+import re
+
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -94,12 +96,44 @@ def load_trace(path: str | Path) -> pd.DataFrame:
         raise
     except Exception as exc:  # pandas/pyarrow raise many types for unreadable files
         raise InputError(str(path), f"cannot read trace: {exc}") from None
-    # the trace's columns say which semantics made it (input names are unique per semantics)
-    sem = _sem.of_columns(frame.columns)
-    missing = [c for c in ("iteration", *sem.inputs, *sem.outputs, "rulebook_sha256") if c not in frame]
+    # the trace's columns say which semantics made it (input names are unique per semantics);
+    # a trace of several arms read by a paper rulebook has them once per arm (``arm<k>_``)
+    columns = arm_view(frame.iloc[0], 1).index if arm_count(frame.columns) else frame.columns
+    sem = _sem.of_columns(columns)
+    missing = [c for c in ("iteration", *sem.inputs, *sem.outputs, "rulebook_sha256")
+               if c not in columns]
     if missing:
         raise InputError(str(path), f"not a Fuzzy-RRT trace: missing column(s) {', '.join(missing)}")
     return frame
+
+
+_ARM_PREFIX = re.compile(r"arm(\d+)_")
+
+
+def arm_count(columns) -> int:
+    """How many arms a trace reads one at a time (``arm<k>_`` column prefixes; 0: none).
+
+    The paper's semantics evaluates its rulebook once per arm, from that arm's end effector, so
+    a trace of two arms has every input, output and fired-rule column twice."""
+    arms = {int(m.group(1)) for c in map(str, columns) if (m := _ARM_PREFIX.match(c))}
+    return max(arms) if arms else 0
+
+
+def arm_view(row: pd.Series, arm: int) -> pd.Series:
+    """Trace row ``row`` as arm ``arm`` (1-based) saw it: its ``arm<k>_`` columns without the
+    prefix, plus the columns every arm shares (sample, box, outcome, ...)."""
+    prefix = f"arm{arm}_"
+    data = {k: v for k, v in row.items() if not _ARM_PREFIX.match(str(k))}
+    data.update({str(k)[len(prefix):]: v for k, v in row.items() if str(k).startswith(prefix)})
+    return pd.Series(data)
+
+
+def explain_rows(row: pd.Series, rulebook) -> list[Explanation]:
+    """One :class:`Explanation` per arm the rulebook read in this row (one without arms)."""
+    n = arm_count(row.index)
+    if not n:
+        return [explain_row(row, rulebook)]
+    return [explain_row(arm_view(row, a), rulebook) for a in range(1, n + 1)]
 
 
 def trace_row(frame: pd.DataFrame, iteration: int, where: str = "--iteration") -> pd.Series:

@@ -17,17 +17,23 @@ def explain(
                                "the numbers bit for bit) instead of 4 significant digits."),
 ) -> int:
     """Print inputs, active terms, fired rules with strengths and contributions, and outputs."""
-    from xfuzzy_rrt.analysis.explain import explain_row, render_text, trace_row
+    from xfuzzy_rrt.analysis.explain import explain_rows, render_text, trace_row
     from xfuzzy_rrt.planners.replay import trace_for
 
     frame, rb = trace_for(source, rulebook)
-    e = explain_row(trace_row(frame, iteration), rb)
-    if exact:
-        typer.echo(render_text(e), nl=False)
-    else:
-        from xfuzzy_rrt.report.explain_text import render_readable, units_of
+    explanations = explain_rows(trace_row(frame, iteration), rb)
+    for a, e in enumerate(explanations):
+        if len(explanations) > 1:  # several arms: the rulebook read each arm's end effector
+            if a:
+                typer.echo("")
+            typer.echo(f"### arm {a + 1} of {len(explanations)} (its own inputs and outputs; "
+                       "the sample, box and outcome are shared)")
+        if exact:
+            typer.echo(render_text(e), nl=False)
+        else:
+            from xfuzzy_rrt.report.explain_text import render_readable, units_of
 
-        typer.echo(render_readable(e, units_of(rb)), nl=False)
+            typer.echo(render_readable(e, units_of(rb)), nl=False)
     return 0
 
 

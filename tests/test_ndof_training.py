@@ -190,3 +190,45 @@ def test_the_default_seed_rulebook_at_n_joints():
     assert seeds == [] or all(s.rulebook.dof == 3 for s in seeds)
     with pytest.raises(InputError, match="seed rulebook is for dof 2, the training for dof 5"):
         resolve_seed_rulebooks([rulebooks_dir() / "expert"], "seeded", "relative", 5)
+
+
+def _tiny_ndof_training(folder, workers: str, scenario, bounds: str, dof: int):
+    import subprocess
+    import sys
+
+    out = folder / "rb"
+    proc = subprocess.run(
+        [sys.executable, "-m", "xfuzzy_rrt.cli.main", "train", "--scenario", str(scenario),
+         "--population", "12", "--generations", "2", "--runs-per-eval", "2", "--max-iter", "400",
+         "--seed", "3", "--bounds", bounds, "--dof", str(dof), "--workers", workers,
+         "--out", "rb"], cwd=folder, capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    import pandas as pd
+
+    files = {p.name: p.read_bytes() for p in sorted(out.iterdir())
+             if p.is_file() and p.name != "history.csv"}
+    history = pd.read_csv(out / "history.csv").drop(
+        columns=[c for c in ("wall_s", "runs_per_s") if c in pd.read_csv(out / "history.csv")])
+    return files, history
+
+
+@pytest.mark.parametrize("arms,dof,bounds,rb_dof", [(1, 3, "relative", 3),
+                                                    (2, 2, "goal-frame", 4)])
+def test_a_tiny_ndof_training_is_identical_with_one_and_two_workers(tmp_path, arms, dof,
+                                                                     bounds, rb_dof):
+    """The paper semantics on one 3-joint arm and the goal-frame semantics on two 2-joint arms:
+    same seed, same rulebook bytes and history, whatever the number of worker processes."""
+    import pandas as pd
+
+    from xfuzzy_rrt.scenarios.generate import generate_nd
+
+    scenario = tmp_path / "p.toml"
+    scenario.write_text(generate_nd(31, 0, dof=dof, arms=arms).text, encoding="utf-8")
+    runs = {}
+    for workers in ("1", "2"):
+        (tmp_path / workers).mkdir()
+        runs[workers] = _tiny_ndof_training(tmp_path / workers, workers, scenario, bounds,
+                                            rb_dof)
+    assert runs["1"][0] == runs["2"][0]
+    assert f"dof = {rb_dof}".encode() in runs["1"][0]["rulebook.toml"]
+    pd.testing.assert_frame_equal(runs["1"][1], runs["2"][1])

@@ -17,10 +17,10 @@ N = 10_000
 
 
 @nb.njit(cache=True)
-def _queries_grid(nodes, cell_next, cell_head, meta, grid, qs):
+def _queries_tree(tree, qs):
     acc = 0
     for j in range(qs.shape[0]):
-        acc += nearest(nodes, cell_next, cell_head, meta, grid, qs[j, 0], qs[j, 1])
+        acc += nearest(tree, qs[j])
     return acc
 
 
@@ -28,27 +28,28 @@ def _queries_grid(nodes, cell_next, cell_head, meta, grid, qs):
 def _queries_brute(nodes, n, qs):
     acc = 0
     for j in range(qs.shape[0]):
-        acc += nearest_brute(nodes, n, qs[j, 0], qs[j, 1])
+        acc += nearest_brute(nodes, n, qs[j])
     return acc
 
 
-@pytest.fixture(scope="module")
-def tree_and_queries():
+@pytest.fixture(scope="module", params=[2, 5, 7], ids=lambda d: f"dof{d}")
+def tree_and_queries(request):
+    """A 10,000-node random-walk tree (RRT-like spatial order) and 10,000 uniform queries."""
+    dof = request.param
     rng = np.random.default_rng(0)
-    steps = rng.normal(0, 6.0, size=(N, 2))
+    steps = rng.normal(0, 6.0, size=(N, dof))
     walk = np.clip(np.cumsum(steps, axis=0) % 360.0 - 180.0, -180, 180)
-    tree = Tree(N, np.array([[-180.0, 180.0], [-180.0, 180.0]]))
+    tree = Tree(N, np.tile([-180.0, 180.0], (dof, 1)))
     for p in walk:
-        add_node(tree.nodes, tree.parent, tree.cell_next, tree.cell_head, tree.meta, tree.grid,
-                 p[0], p[1], -1)
-    return tree, rng.uniform(-180, 180, size=(N, 2))
+        add_node(tree, np.ascontiguousarray(p), -1)
+    return tree, rng.uniform(-180, 180, size=(N, dof))
 
 
-def test_nearest_grid_10k(benchmark, tree_and_queries):
+def test_nearest_tree_10k(benchmark, tree_and_queries):
+    """Grid (2 joints) or k-d tree (5, 7 joints): exact, and far below the brute-force cost."""
     tree, qs = tree_and_queries
-    args = (tree.nodes, tree.cell_next, tree.cell_head, tree.meta, tree.grid, qs)
     expected = _queries_brute(tree.nodes, N, qs)
-    assert benchmark(_queries_grid, *args) == expected
+    assert benchmark(_queries_tree, tree, qs) == expected
     benchmark.extra_info["per_query_us"] = benchmark.stats.stats.median / N * 1e6
 
 

@@ -55,3 +55,33 @@ def test_principles_hold():
     # bias falls as the obstacle gets closer, for every goal situation (smooth, monotone)
     bias = c["goal_bias"].reshape(5, 5, 5, 5)
     assert np.all(np.diff(bias, axis=3) >= 0)
+
+
+def test_the_five_dof_expert_is_what_the_script_generates(tmp_path):
+    """``--dof 5``: the shipped ``expert-5dof`` byte for byte, and the 2-DOF principles per
+    joint (every joint the same symmetric window as the 2-DOF expert's)."""
+    folder = PROJECT / "rulebooks" / "expert-5dof"
+    shipped = load_rulebook(folder)
+    assert shipped.dof == 5 and shipped.outputs[1:-1] == tuple(f"bound_{k}" for k in range(1, 11))
+    proc = subprocess.run(
+        [sys.executable, str(PROJECT / "scripts" / "make_expert_rulebook.py"), "--dof", "5",
+         "--out", str(tmp_path), "--date", str(shipped.provenance["date"])],
+        capture_output=True, text=True, timeout=120,
+    )
+    assert proc.returncode == 0, proc.stderr
+    for output in shipped.outputs:
+        assert (tmp_path / f"{output}.fis").read_bytes() == (folder / f"{output}.fis").read_bytes()
+    two = load_rulebook(EXPERT)
+    for name in ("goal_bias", "step_size"):
+        assert shipped.system(name).consts == two.system(name).consts
+    for j in range(1, 6):
+        assert shipped.system(f"bound_{2 * j - 1}").consts == two.system("bound_1").consts
+        assert shipped.system(f"bound_{2 * j}").consts == two.system("bound_2").consts
+
+
+def test_the_script_refuses_a_dof_outside_two_to_seven(tmp_path):
+    proc = subprocess.run(
+        [sys.executable, str(PROJECT / "scripts" / "make_expert_rulebook.py"), "--dof", "8",
+         "--out", str(tmp_path / "x")], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "--dof: dof must be an integer from 2 to 7" in proc.stderr
+    assert not (tmp_path / "x").exists()

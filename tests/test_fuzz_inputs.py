@@ -491,7 +491,7 @@ def test_deeply_nested_rulebook_manifest_is_a_lint_error_not_a_crash(tmp_path):
 def test_geometry_too_large_for_float64_is_rejected_before_it_can_fool_the_check(tmp_path):
     """1e160 m links used to overflow the squared distances to inf, and the certified check
     then 'certified' a sweep straight through a box in one infinite step."""
-    from xfuzzy_rrt.geometry.collision import edge_free
+    from single_arm import edge_free
 
     links, base = np.array([1e160]), np.zeros(2)
     box = np.array([[1.0, 2e159, -1.0, 3e159, 1.0]])  # on the x axis, crossed at q = 0

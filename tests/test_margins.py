@@ -28,12 +28,8 @@ from xfuzzy_rrt.geometry.clearance import (
     resolve_clearance,
     with_clearance,
 )
-from xfuzzy_rrt.geometry.collision import (
-    CERT_MARGIN_M,
-    config_free,
-    edge_free,
-    effective_margin,
-)
+from single_arm import arrays_of, config_free, edge_free
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, effective_margin
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
 from xfuzzy_rrt.planners.rrt import plan_rrt
@@ -143,7 +139,7 @@ def test_random_arms_certified_with_a_clearance_keep_it_everywhere(case):
     oracle = Oracle.from_arrays(links, base, radius, obstacles)
     assert oracle.keeps_margin([qa, qb], clearance, resolution_deg=0.05) == []
     exact = path_min_clearance(
-        types.SimpleNamespace(links=links, base=base, link_radius=radius, obstacles=obstacles),
+        arrays_of(links, base, radius, obstacles),
         np.array([qa, qb]))
     assert exact.lower_bound_m >= clearance
 
@@ -234,8 +230,8 @@ def test_a_start_closer_than_the_clearance_is_refused_naming_the_option():
     a = s.arrays()
     from xfuzzy_rrt.geometry.collision import clearance_kernel
 
-    start = float(clearance_kernel(a.links, a.base, a.link_radius, a.obstacles, a.start_deg))
-    goal = float(clearance_kernel(a.links, a.base, a.link_radius, a.obstacles, a.goal_deg))
+    start = float(clearance_kernel(a.problem(CERT_MARGIN_M), a.start_deg))
+    goal = float(clearance_kernel(a.problem(CERT_MARGIN_M), a.goal_deg))
     with pytest.raises(InputError) as err:
         plan_rrt(s, clearance_m=min(start, goal) + 1e-4)
     assert err.value.where == "--clearance"
@@ -296,8 +292,7 @@ def test_cli_plan_with_a_clearance_writes_a_path_that_keeps_it(tmp_path):
 @given(case=margin_cases())
 def test_path_min_clearance_agrees_with_the_dense_exact_oracle(case):
     links, base, radius, qa, qb, _, obstacles = case
-    arrays = types.SimpleNamespace(links=links, base=base, link_radius=radius,
-                                   obstacles=obstacles)
+    arrays = arrays_of(links, base, radius, obstacles)
     mid = qa + 0.37 * (qb - qa)
     path = np.array([qa, mid, qb])
     ours = path_min_clearance(arrays, path)

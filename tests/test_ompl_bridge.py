@@ -16,7 +16,8 @@ from conftest import FIXTURES, PROJECT, shared_scenarios, thin_box
 from exact_geometry import Oracle
 from xfuzzy_rrt.cli.main import main
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, config_free
+from single_arm import config_free
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
 from xfuzzy_rrt.geometry.path_check import certify_path
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.api import PLANNERS, check_planner, is_known_planner, plan_scenario

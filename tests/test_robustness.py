@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from single_arm import arrays_of
 from tests.conftest import FIXTURES
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import load_scenario
@@ -32,8 +33,7 @@ TWO = FIXTURES / "scenarios" / "two-circles.toml"
 
 
 def _one_link(obstacles, radius=0.0):
-    return types.SimpleNamespace(links=np.array([L]), base=np.zeros(2), link_radius=radius,
-                                 obstacles=np.array(obstacles, dtype=float))
+    return arrays_of(np.array([L]), np.zeros(2), radius, np.array(obstacles, dtype=float))
 
 
 @pytest.mark.parametrize("gap, r, sigma", [(0.003, 0.002, 0.002), (0.006, 0.004, 0.003),

@@ -75,20 +75,23 @@ def test_rng_matches_its_pure_python_replay():
 
 
 @settings(max_examples=60, deadline=None)
-@given(seed=st.integers(0, 2**32), n=st.integers(1, 3000), clustered=st.booleans())
-def test_grid_nearest_neighbour_equals_brute_force(seed, n, clustered):
+@given(seed=st.integers(0, 2**32), n=st.integers(1, 3000), clustered=st.booleans(),
+       dof=st.sampled_from([2, 3, 5, 7]))
+def test_nearest_neighbour_equals_brute_force_in_any_dimension(seed, n, clustered, dof):
+    """The 2-joint grid and the k-d tree (3+ joints) give the brute-force answer, ties to the
+    lowest index included (rounded clustered points make many exact ties)."""
     rng = np.random.default_rng(seed)
-    limits = np.array([[-180.0, 180.0], [-180.0, 180.0]])
+    limits = np.tile([-180.0, 180.0], (dof, 1))
     tree = Tree(n, limits)
     if clustered:
-        pts = rng.normal(rng.uniform(-150, 150, 2), 8.0, size=(n, 2)).clip(-180, 180)
+        pts = rng.normal(rng.uniform(-150, 150, dof), 8.0, size=(n, dof)).clip(-180, 180)
         pts = np.round(pts)  # many exact ties
     else:
-        pts = rng.uniform(-180, 180, size=(n, 2))
+        pts = rng.uniform(-180, 180, size=(n, dof))
     for p in pts:
-        add_node(tree.nodes, tree.parent, tree.cell_next, tree.cell_head, tree.meta, tree.grid,
-                 p[0], p[1], -1)
-    for q in np.vstack([rng.uniform(-180, 180, size=(50, 2)), pts[:5], [[180.0, 180.0]]]):
-        got = nearest(tree.nodes, tree.cell_next, tree.cell_head, tree.meta, tree.grid, q[0], q[1])
-        want = nearest_brute(tree.nodes, n, q[0], q[1])
+        add_node(tree, p, -1)
+    for q in np.vstack([rng.uniform(-180, 180, size=(50, dof)), pts[:5],
+                        np.full((1, dof), 180.0)]):
+        got = nearest(tree, q)
+        want = nearest_brute(tree.nodes, n, q)
         assert got == want

@@ -25,12 +25,8 @@ import shapely
 from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
-from xfuzzy_rrt.geometry.collision import (
-    CERT_MARGIN_M,
-    clearance_kernel,
-    edge_free,
-    link_motion_bound,
-)
+from single_arm import clearance_kernel, edge_free
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, link_motion_bound
 
 SETTINGS = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow])
@@ -313,6 +309,7 @@ from xfuzzy_rrt.planners.result import (  # noqa: E402
     NODE_IN_COLLISION,
     path_cost_deg,
 )
+from xfuzzy_rrt.geometry.problem import single_arm_problem  # noqa: E402
 from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path  # noqa: E402
 
 ARM2 = np.array([0.2, 0.1])
@@ -328,8 +325,7 @@ class _Ext:
         self.goal = np.asarray(goal, dtype=float)
         self.tree = Tree(capacity, LIMITS2)
         t = self.tree
-        add_node(t.nodes, t.parent, t.cell_next, t.cell_head, t.meta, t.grid,
-                 float(root[0]), float(root[1]), -1)
+        add_node(t, np.array([float(root[0]), float(root[1])]), -1)
         self.q_near = np.empty(2)
         self.q_new = np.empty(2)
 
@@ -339,10 +335,10 @@ class _Ext:
 
     def extend(self, near, sample, step):
         t = self.tree
-        return extend(ARM2, np.zeros(2), self.radius, self.obstacles, LIMITS2, self.goal,
-                      CERT_MARGIN_M, t.nodes, t.parent, t.cell_next, t.cell_head, t.meta, t.grid,
-                      near, float(sample[0]), float(sample[1]), float(step), self.q_near,
-                      self.q_new)
+        problem = single_arm_problem(ARM2, np.zeros(2), self.radius, self.obstacles, LIMITS2,
+                                     goal=self.goal, margin=CERT_MARGIN_M)
+        return extend(problem, t, near, np.array([float(sample[0]), float(sample[1])]),
+                      float(step), self.q_near, self.q_new)
 
 
 def _thin_circle_on_tip_path(q_from, q_to, s_hit=0.5, rho=1e-4):
@@ -472,7 +468,7 @@ def test_every_edge_extend_adds_is_collision_free_and_at_most_one_step_long(
 def _chain_tree(points, parents):
     t = Tree(len(points) + 1, LIMITS2)
     for (x, y), p in zip(points, parents):
-        add_node(t.nodes, t.parent, t.cell_next, t.cell_head, t.meta, t.grid, x, y, p)
+        add_node(t, np.array([float(x), float(y)]), p)
     return t
 
 
@@ -488,7 +484,7 @@ def test_extract_path_follows_parents_from_the_root_to_the_node():
 
 def test_add_node_records_position_parent_and_count():
     t = _chain_tree([(0.5, -0.5)], [-1])
-    i = add_node(t.nodes, t.parent, t.cell_next, t.cell_head, t.meta, t.grid, 7.25, -3.5, 0)
+    i = add_node(t, np.array([7.25, -3.5]), 0)
     assert i == 1 and t.meta[0] == 2
     assert tuple(t.nodes[1]) == (7.25, -3.5) and t.parent[1] == 0
 
@@ -528,8 +524,8 @@ def test_rrt_paths_pass_the_exact_oracle_on_a_fixture_scenario():
 
 import warnings  # noqa: E402
 
+from single_arm import config_free  # noqa: E402
 from xfuzzy_rrt.geometry.collision import (  # noqa: E402
-    config_free,
     direction_and_distance,
     nearest_obstacle_from_point,
 )
@@ -728,9 +724,13 @@ def test_segment_distance_is_exact_for_points_and_axis_parallel_segments(a, b, o
 
 
 def _arrays(obstacles, limits=LIMITS2, radius=0.0):
-    return SimpleNamespace(links=ARM2, base=np.zeros(2), link_radius=radius,
-                           obstacles=np.asarray(obstacles, dtype=float),
-                           limits_deg=np.asarray(limits, dtype=float))
+    obstacles = np.asarray(obstacles, dtype=float).reshape(-1, 5)
+    limits = np.asarray(limits, dtype=float)
+    return SimpleNamespace(
+        links=ARM2, base=np.zeros(2), link_radius=radius, obstacles=obstacles,
+        limits_deg=limits,
+        problem=lambda margin: single_arm_problem(ARM2, np.zeros(2), radius, obstacles, limits,
+                                                  margin=margin))
 
 
 def test_touching_counts_as_a_collision():

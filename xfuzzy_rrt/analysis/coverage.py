@@ -1,4 +1,7 @@
-"""Which of a rulebook's 6 x 625 rules actually drive the planner: rule coverage over runs.
+"""Which of a rulebook's n_out x 625 rules actually drive the planner: rule coverage over runs.
+
+``n_out`` is the rulebook's number of FIS (6 at 2 DOF; ``2N + 2`` for a paper rulebook of N
+joints); every array and table below has one block per FIS, in the rulebook's output order.
 
 Definitions (per FIS and rule ``r``, over every iteration ``i`` of every run considered;
 ``w_{r,i}`` is the *normalised* firing strength recorded in the trace, so ``Σ_r w_{r,i} = 1``
@@ -21,7 +24,7 @@ and the output at iteration ``i`` is ``Σ_r w_{r,i} c_r``):
   that fired at least once.
 
 The counts are accumulated run by run into plain arrays (:class:`CoverageCounts`), so runs can
-be planned in worker processes and only 4 x 6 x 625 numbers travel back; sums are taken in run
+be planned in worker processes and only 4 x n_out x 625 numbers travel back; sums are taken in run
 order, so the result does not depend on the number of workers.
 """
 
@@ -49,7 +52,10 @@ MASS_TARGET = 0.9
 
 @dataclass
 class CoverageCounts:
-    """Raw sums over iterations, arrays float64/int64[6, 625] (see the module docstring)."""
+    """Raw sums over iterations, arrays float64/int64[n_out, 625] (see the module docstring).
+
+    The default is the 2-DOF shape (6 FIS); use :meth:`empty` for a rulebook's own.
+    """
 
     fired: np.ndarray = field(default_factory=lambda: np.zeros((N_OUTPUTS, N_RULES), np.int64))
     strength: np.ndarray = field(default_factory=lambda: np.zeros((N_OUTPUTS, N_RULES)))
@@ -59,7 +65,17 @@ class CoverageCounts:
     runs: int = 0
     successes: int = 0
 
+    @classmethod
+    def empty(cls, n_out: int = N_OUTPUTS) -> "CoverageCounts":
+        """Zero counts for a rulebook of *n_out* FIS (``rulebook.n_outputs``)."""
+        return cls(fired=np.zeros((n_out, N_RULES), np.int64), strength=np.zeros((n_out, N_RULES)),
+                   fired_on_path=np.zeros((n_out, N_RULES), np.int64),
+                   strength_on_path=np.zeros((n_out, N_RULES)))
+
     def add(self, other: "CoverageCounts") -> None:
+        if other.fired.shape != self.fired.shape:
+            raise InputError("trace", f"counts for {other.fired.shape[0]} fuzzy systems cannot "
+                             f"be added to counts for {self.fired.shape[0]} (another DOF)")
         self.fired += other.fired
         self.strength += other.strength
         self.fired_on_path += other.fired_on_path
@@ -77,7 +93,8 @@ def counts_from_trace(trace: pd.DataFrame, success: bool | None = None) -> Cover
     if missing:
         raise InputError("trace", f"not a Fuzzy-RRT trace (missing column {missing[0]!r})")
     n = len(trace)
-    c = CoverageCounts(iterations=n, runs=1)
+    c = CoverageCounts.empty(len(outputs))
+    c.iterations, c.runs = n, 1
     if success is None:
         success = bool(n and "outcome" in trace and str(trace["outcome"].iloc[-1]) == "goal_reached")
     c.successes = int(success)
@@ -115,7 +132,7 @@ def collect_counts(rulebook, scenarios, runs: int = 10, seed: int = 0, max_iter:
     if workers < 1:
         raise InputError("--workers", f"must be >= 1, got {workers}")
     jobs = [(s, rulebook, seed + k, max_iter) for s in scenarios for k in range(runs)]
-    total = CoverageCounts()
+    total = CoverageCounts.empty(len(rulebook.outputs))
     if workers == 1 or len(jobs) == 1:
         parts = map(_one, jobs)
         for p in parts:
@@ -131,7 +148,7 @@ def counts_from_trace_files(paths, rulebook) -> CoverageCounts:
     """Sum the counts of saved traces; each must have been made by *rulebook* (sha256)."""
     from xfuzzy_rrt.analysis.explain import load_trace
 
-    total = CoverageCounts()
+    total = CoverageCounts.empty(len(rulebook.outputs))
     for path in paths:
         frame = load_trace(Path(path))
         if "rulebook_sha256" in frame and len(frame):
@@ -150,7 +167,8 @@ def antecedent_text(rulebook, f: int, r: int) -> str:
 
 
 def coverage_frame(counts: CoverageCounts, rulebook) -> pd.DataFrame:
-    """One row per FIS and rule (6 x 625 rows, dead rules included); columns COVERAGE_COLUMNS."""
+    """One row per FIS and rule (n_out x 625 rows, dead rules included); columns
+    COVERAGE_COLUMNS."""
     parts = []
     n = max(counts.iterations, 1)
     for f, out in enumerate(rulebook.outputs):
@@ -188,7 +206,7 @@ def coverage_frame(counts: CoverageCounts, rulebook) -> pd.DataFrame:
 
 
 def coverage_summary(coverage: pd.DataFrame, iterations: int) -> pd.DataFrame:
-    """Per FIS plus an ``all`` row over the 3,750 rules: fired rules, coverage, dead rules,
+    """Per FIS plus an ``all`` row over all rules (3,750 at 2 DOF): fired rules, coverage, dead rules,
     rules carrying 90 % of the mass and their share of the rules."""
     rows = []
     for out, g in coverage.groupby("output", sort=False):

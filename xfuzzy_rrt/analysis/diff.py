@@ -23,13 +23,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.manifest import thaw
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_RULES, rule_terms
 
 CELL_COLUMNS = ["output", "rule", "antecedent", "a", "b", "delta"]
 PEAK_COLUMNS = ["output", "input", "term", "a", "b", "shift"]
 META_COLUMNS = ["field", "a", "b"]
-#: What a decision is beside the six outputs (whose names come from the rulebooks' semantics).
+#: What a decision is beside the outputs (whose names come from the rulebooks' semantics), for
+#: a 2-DOF trace; :func:`decision_columns` gives those of a trace of any DOF.
 DECISION_COLUMNS = ["goal_sampled", "sample_q1_deg", "sample_q2_deg", "outcome",
                     "new_node"]
 CAUSE_COLUMNS = ["output", "rule", "antecedent", "strength_a", "strength_b", "constant_a",
@@ -77,7 +79,15 @@ def _flat(prefix: str, value: Any, out: dict[str, Any]) -> None:
 
 
 def diff_rulebooks(a, b) -> RulebookDiff:
-    """Compare two loaded rulebooks (see the module docstring)."""
+    """Compare two loaded rulebooks (see the module docstring).
+
+    Both must have the same semantics and DOF: their systems are compared cell by cell, and a
+    rulebook for another arm has other outputs (``InputError`` naming both).
+    """
+    if (a.semantics.name, a.dof) != (b.semantics.name, b.dof):
+        raise InputError("b", f"cannot compare rulebook {a.name!r} ({a.semantics.name} "
+                         f"semantics, dof {a.dof}) with {b.name!r} ({b.semantics.name} "
+                         f"semantics, dof {b.dof}): their fuzzy systems differ")
     cells, peaks, doc = [], [], []
     for fa, fb in zip(a.systems, b.systems):
         ca = np.asarray(fa.consts)
@@ -145,17 +155,28 @@ class ReplayDiff:
 PLAN_COLUMNS = ["goal_sampled", "sample_q1_deg", "sample_q2_deg", "outcome", "new_node"]
 
 
+def decision_columns(trace: pd.DataFrame) -> list[str]:
+    """DECISION_COLUMNS (= PLAN_COLUMNS) for the joints the trace has: ``sample_q1_deg …
+    sample_qN_deg`` (a trace of N joints has N sample columns; 2 when it shows none)."""
+    n = 0
+    while f"sample_q{n + 1}_deg" in trace.columns:
+        n += 1
+    return ["goal_sampled", *(f"sample_q{j}_deg" for j in range(1, max(n, 2) + 1)),
+            "outcome", "new_node"]
+
+
 def first_divergence(ta: pd.DataFrame, tb: pd.DataFrame, columns=None) -> int | None:
     """First 1-based iteration where the decisions of two traces differ (None: never).
 
-    A decision is the six outputs (named by the traces' semantics) and DECISION_COLUMNS. When
+    A decision is the outputs (named by the traces' semantics) and the decision columns
+    (:func:`decision_columns`: the sample in every joint, goal sampled, outcome, node). When
     one trace is a prefix of the other (one run stopped earlier), the divergence is the first
     iteration past the shorter one.
     """
     if columns is None:
         from xfuzzy_rrt.fuzzy import semantics as _sem
 
-        columns = [*_sem.of_columns(ta.columns).outputs, *DECISION_COLUMNS]
+        columns = [*_sem.of_columns(ta.columns).outputs, *decision_columns(ta)]
     n = min(len(ta), len(tb))
     for c in columns:
         if c not in ta.columns or c not in tb.columns:
@@ -190,7 +211,7 @@ def replay_diff(scenario, a, b, seed: int = 0, max_iter: int = 10_000) -> Replay
     rb = plan_scenario(scenario, "fuzzy-rrt", rulebook=b, seed=seed, max_iter=max_iter, trace=True)
     ta, tb = ra.trace, rb.trace
     it = first_divergence(ta, tb)
-    plan_it = first_divergence(ta, tb, PLAN_COLUMNS)
+    plan_it = first_divergence(ta, tb, decision_columns(ta))
     decisions, causes = _explain_row(ta, tb, it, a, b)
     _, plan_causes = _explain_row(ta, tb, plan_it, a, b)
     return ReplayDiff(scenario=scenario.name, seed=int(seed), result_a=ra, result_b=rb,
@@ -209,7 +230,7 @@ def _explain_row(ta, tb, it, a, b) -> tuple[pd.DataFrame, pd.DataFrame]:
         return pd.DataFrame([("iterations", len(ta), len(tb))], columns=["quantity", "a", "b"]), causes
     row = it - 1
     drows = []
-    for c in [*a.inputs, *a.outputs, *DECISION_COLUMNS]:
+    for c in [*a.inputs, *a.outputs, *decision_columns(ta)]:
         if c not in ta or c not in tb:
             continue
         va, vb = ta[c].iloc[row], tb[c].iloc[row]

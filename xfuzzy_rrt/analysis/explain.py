@@ -1,7 +1,7 @@
 """Explain one Fuzzy-RRT expansion so that an auditor can re-derive every number by hand.
 
 Given a trace row and the rulebook that produced it, :func:`explain_row` lists for each of the
-six fuzzy systems: the (clamped) inputs, the terms active on each input with their membership
+rulebook's fuzzy systems (six at 2 DOF; ``2N + 2`` for a paper rulebook of N joints): the (clamped) inputs, the terms active on each input with their membership
 degrees (each system has its own term peaks), every fired rule as a sentence with its constant,
 normalised strength and contribution ``strength × constant``, and the output — recomputed here
 from the rulebook as ``Σ strength × constant`` and compared with the value the compiled planner
@@ -95,7 +95,7 @@ def load_trace(path: str | Path) -> pd.DataFrame:
     except Exception as exc:  # pandas/pyarrow raise many types for unreadable files
         raise InputError(str(path), f"cannot read trace: {exc}") from None
     # the trace's columns say which semantics made it (input names are unique per semantics)
-    sem = next((s for s in _sem.SEMANTICS.values() if s.inputs[0] in frame), _sem.PAPER)
+    sem = _sem.of_columns(frame.columns)
     missing = [c for c in ("iteration", *sem.inputs, *sem.outputs, "rulebook_sha256") if c not in frame]
     if missing:
         raise InputError(str(path), f"not a Fuzzy-RRT trace: missing column(s) {', '.join(missing)}")
@@ -147,14 +147,48 @@ def explain_row(row: pd.Series, rulebook) -> Explanation:
         value = sum(rr.contribution for rr in rules)
         systems.append(SystemExplanation(output=output, active=active, rules=tuple(rules),
                                          value=value, traced_value=float(row[output])))
+    js = trace_joints(row.index) or [1, 2]
     decision = {k: row[k] for k in (
-        "from_node", "from_q1_deg", "from_q2_deg", "box_q1_lo", "box_q1_hi", "box_q2_lo",
-        "box_q2_hi", "step_used_deg", "goal_sampled", "sample_q1_deg", "sample_q2_deg",
-        "nearest_node", "new_q1_deg", "new_q2_deg", "outcome", "new_node", "tree_size", "on_path")
+        "from_node", *(f"from_q{j}_deg" for j in js),
+        *(c for j in js for c in (f"box_q{j}_lo", f"box_q{j}_hi")),
+        "step_used_deg", "goal_sampled", *(f"sample_q{j}_deg" for j in js),
+        "nearest_node", *(f"new_q{j}_deg" for j in js), "outcome", "new_node", "tree_size",
+        "on_path")
         if k in row}
     return Explanation(iteration=int(row["iteration"]), rulebook=rulebook.name,
                        bounds_mode=rulebook.bounds_mode, inputs=x, clamped_inputs=clamped,
                        systems=tuple(systems), decision=decision)
+
+
+def trace_joints(columns) -> list[int]:
+    """Joint numbers ``1 … N`` whose ``box_q<j>_lo`` column a trace has (the trace's DOF).
+
+    Why from the columns: a trace of N joints carries ``*_q1 … *_qN`` columns, and explaining
+    must not assume two.
+    """
+    cols = set(map(str, columns))
+    n = 0
+    while f"box_q{n + 1}_lo" in cols or f"new_q{n + 1}_deg" in cols:
+        n += 1
+    return list(range(1, n + 1))
+
+
+def _joints_text(d: dict, fmt: str) -> list[str]:
+    """``[fmt(j)…]`` values of every joint present in decision *d*, e.g. ``sample_q{j}_deg``."""
+    out, j = [], 1
+    while fmt.format(j=j) in d:
+        out.append(f"{d[fmt.format(j=j)]:.6g}")
+        j += 1
+    return out
+
+
+def _box_text(d: dict) -> str:
+    """``joint 1 [lo, hi] deg, joint 2 [lo, hi] deg, …`` for every joint in the decision."""
+    parts, j = [], 1
+    while f"box_q{j}_lo" in d:
+        parts.append(f"joint {j} [{d[f'box_q{j}_lo']:.6g}, {d[f'box_q{j}_hi']:.6g}] deg")
+        j += 1
+    return ", ".join(parts)
 
 
 def header_lines(e: Explanation) -> list[str]:
@@ -188,24 +222,21 @@ def render_text(e: Explanation) -> str:
         lines += ["", "Decision:"]
         if "box_q1_lo" in d and not e.bounds_mode:
             lines.append(f"  sampling region (bounding box of the box along the direction to the "
-                         f"goal, or the whole joint space for a uniform sample): joint 1 "
-                         f"[{d['box_q1_lo']:.6g}, {d['box_q1_hi']:.6g}] deg, joint 2 "
-                         f"[{d['box_q2_lo']:.6g}, {d['box_q2_hi']:.6g}] deg")
+                         f"goal, or the whole joint space for a uniform sample): {_box_text(d)}")
         elif "box_q1_lo" in d:
-            lines.append(f"  sampling box: joint 1 [{d['box_q1_lo']:.6g}, {d['box_q1_hi']:.6g}] deg, "
-                         f"joint 2 [{d['box_q2_lo']:.6g}, {d['box_q2_hi']:.6g}] deg"
+            lines.append(f"  sampling box: {_box_text(d)}"
                          + (f" (bounds offset from node {int(d['from_node'])} at "
-                            f"[{d['from_q1_deg']:.6g}, {d['from_q2_deg']:.6g}], clipped to the joint limits)"
+                            f"[{', '.join(_joints_text(d, 'from_q{j}_deg'))}], clipped to the joint limits)"
                             if e.bounds_mode == "relative" else " (clipped to the joint limits)"))
         if "step_used_deg" in d:
             lines.append(f"  step used: {d['step_used_deg']:.6g} deg")
         if "sample_q1_deg" in d:
             src = ("the goal (goal bias)" if bool(d.get("goal_sampled"))
                    else "uniform in the box" if e.bounds_mode else "uniform in the region")
-            lines.append(f"  sample: [{d['sample_q1_deg']:.6g}, {d['sample_q2_deg']:.6g}] from {src}")
+            lines.append(f"  sample: [{', '.join(_joints_text(d, 'sample_q{j}_deg'))}] from {src}")
         if "nearest_node" in d:
             lines.append(f"  nearest node: {int(d['nearest_node'])}; new configuration "
-                         f"[{d['new_q1_deg']:.6g}, {d['new_q2_deg']:.6g}]")
+                         f"[{', '.join(_joints_text(d, 'new_q{j}_deg'))}]")
         if "outcome" in d:
             lines.append(f"  outcome: {d['outcome']}; tree size {int(d['tree_size'])}; "
                          f"on final path: {bool(d.get('on_path'))}")

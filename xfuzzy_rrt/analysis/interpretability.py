@@ -47,7 +47,7 @@ def measures(rulebook, compact: bool = True, fired=None) -> pd.DataFrame:
     """One row per FIS (columns MEASURE_COLUMNS) plus a ``total``/mean row.
 
     ``compact`` measures the rulebook as the compact layout writes it (else the full 625-rule
-    layout); ``fired`` is an optional int[6, 625] of firing counts (dead = 0).
+    layout); ``fired`` is an optional int[n_out, 625] of firing counts (dead = 0).
     """
     rows = []
     for f, s in enumerate(rulebook.systems):

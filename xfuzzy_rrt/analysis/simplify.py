@@ -49,7 +49,7 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.cover import Partition, min_partition
 from xfuzzy_rrt.fuzzy.manifest import thaw
 from xfuzzy_rrt.fuzzy.system import FuzzySystem
-from xfuzzy_rrt.fuzzy.variables import N_OUTPUTS, N_RULES
+from xfuzzy_rrt.fuzzy.variables import N_RULES
 
 LEVEL_LADDER = (2, 3, 4, 5, 6, 8, 12, 16, 24, 32)
 TOLERANCE_LADDER = (0.5, 0.4, 0.3, 0.25, 0.2, 0.15, 0.1, 0.05, 0.02, 0.01)
@@ -145,7 +145,7 @@ def build_candidate(rulebook, levels: int | None = None, tolerance: float = 0.0,
                     free=None, absorb: float | None = None, label: str = "") -> Candidate:
     """Apply the lossy steps (if any) and the fewest-rules partition to every FIS."""
     parts = []
-    consts = np.empty((N_OUTPUTS, N_RULES))
+    consts = np.empty((len(rulebook.systems), N_RULES))
     for f, s in enumerate(rulebook.systems):
         lo, hi = s.range
         v = np.asarray(s.consts, dtype=np.float64)
@@ -170,10 +170,12 @@ def with_consts(rulebook, consts, name: str, provenance: dict):
     """A copy of *rulebook* with new constants (same peaks, term names, bounds mode)."""
     from xfuzzy_rrt.fuzzy.rulebook import Rulebook
 
-    systems = tuple(FuzzySystem(output=s.output, inputs=s.inputs, consts=tuple(consts[f].tolist()))
+    systems = tuple(FuzzySystem(output=s.output, inputs=s.inputs, consts=tuple(consts[f].tolist()),
+                                dof=s.dof)
                     for f, s in enumerate(rulebook.systems))
     return Rulebook(name=name, bounds_mode=rulebook.bounds_mode, systems=systems,
-                    provenance=provenance, description=rulebook.description)
+                    provenance=provenance, description=rulebook.description,
+                    semantics=rulebook.semantics)
 
 
 # ------------------------------------------------------------------------- measurement

@@ -34,8 +34,8 @@ def _out(text: str) -> None:
 @app.command("eval")
 def eval_(
     rulebook: Path = typer.Argument(..., help="Rulebook directory."),
-    input: Path = typer.Option(..., "--input", help="CSV with angle_to_goal, dist_to_goal, angle_to_obstacle, dist_to_obstacle."),
-    output: Path = typer.Option(..., "--output", help="CSV to write: the input rows with the six outputs appended."),
+    input: Path = typer.Option(..., "--input", help="CSV with the rulebook's four inputs (paper: angle_to_goal, dist_to_goal, angle_to_obstacle, dist_to_obstacle)."),
+    output: Path = typer.Option(..., "--output", help="CSV to write: the input rows with the rulebook's outputs appended (six at 2 DOF; goal_bias, bound_1 ... bound_2N, step_size for a paper rulebook of N joints)."),
 ) -> int:
     """Evaluate the rulebook on every row of a CSV (inputs outside a range are clamped)."""
     from xfuzzy_rrt.atomic import atomic_path
@@ -81,6 +81,8 @@ def lint(rulebook: Path = typer.Argument(..., help="Rulebook directory.")) -> in
 
     rb = load_rulebook(rulebook)
     kind = f"{rb.bounds_mode} bounds" if rb.bounds_mode else f"{rb.semantics.name} semantics"
+    if rb.dof != 2:  # 2-DOF lines stay as they were
+        kind += f", dof {rb.dof}: {len(rb.systems)} FIS"
     _out(f"ok: {rulebook}: rulebook {rb.name!r} ({kind}), sha256 {rb.sha256}")
     return 0
 
@@ -146,6 +148,7 @@ def show(
 
     lines = [f"rulebook {rb.name!r}  ({rulebook})", f"  semantics: {rb.semantics.summary}",
              f"  bounds mode: {rb.bounds_mode or '(none: not the paper semantics)'}",
+             f"  dof: {rb.dof} ({len(rb.systems)} FIS: {rb.outputs[0]} \u2026 {rb.outputs[-1]})",
              f"  sha256: {rb.sha256}"]
     if rb.description:
         lines.append(f"  description: {rb.description}")
@@ -214,7 +217,7 @@ def export(
 
 @app.command("import")
 def import_(
-    fll_dir: Path = typer.Argument(..., help="Directory with goal_bias.fll ... step_size.fll."),
+    fll_dir: Path = typer.Argument(..., help="Directory with goal_bias.fll ... step_size.fll (the DOF follows from the bound_K.fll files present)."),
     out: Path = typer.Option(..., "--out", help="Rulebook directory to write."),
     name: Optional[str] = typer.Option(None, "--name", help="Rulebook name (default: from the export, else the directory name)."),
     bounds_mode: Optional[BoundsMode] = typer.Option(
@@ -277,7 +280,7 @@ def coverage(
     seed: int = typer.Option(0, "--seed", help="First seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run."),
     workers: int = typer.Option(1, "--workers", min=1, help="Worker processes."),
-    out: Optional[Path] = typer.Option(None, "--out", help="CSV: one row per FIS and rule (3,750 rows)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="CSV: one row per FIS and rule (3,750 rows at 2 DOF)."),
     html: Optional[Path] = typer.Option(None, "--html", help="HTML page with 25x25 heatmaps per FIS."),
     top: int = typer.Option(5, "--top", min=0, help="Rules to list per FIS (largest output mass)."),
 ) -> int:

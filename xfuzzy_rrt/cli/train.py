@@ -86,8 +86,9 @@ def train(
     validation_runs: int = typer.Option(50, "--validation-runs", help="Runs per scenario to choose the final rulebook."),
     name: Optional[str] = typer.Option(None, "--name", help="Rulebook name (default: the --out folder's name)."),
     clearance: Optional[float] = typer.Option(None, "--clearance", help="Certified clearance in metres the planner must keep while training (default: each scenario's, else 0)."),
+    dof: Optional[int] = typer.Option(None, "--dof", help="Joints of the rulebook to train, 2..7 (default: the training scenarios' own, which must agree: per arm for the paper's semantics, of all arms together for goal-frame). The genome has (2N+2) x 637 genes for the paper's semantics at N joints, 6 x 637 for goal-frame."),
 ) -> int:
-    """Train the six fuzzy systems with the paper's genetic algorithm; write a rulebook."""
+    """Train the fuzzy systems (six at 2 DOF) with the paper's genetic algorithm; write a rulebook."""
     import dataclasses
 
     from xfuzzy_rrt.errors import InputError
@@ -97,6 +98,7 @@ def train(
         load_training_scenarios,
         resolve_seed_rulebooks,
         run_training,
+        training_dof,
     )
 
     if workers is not None and workers < 1:
@@ -105,6 +107,8 @@ def train(
 
     scenarios = load_training_scenarios(scenario)
     held_out = load_training_scenarios(validation_scenario) if validation_scenario else []
+    # before any planning: scenarios of mixed DOF, or a --dof that disagrees, are one line
+    dof = training_dof([*scenarios, *held_out], bounds, dof)
     if clearance is not None:
         from xfuzzy_rrt.geometry.clearance import with_clearance
 
@@ -129,9 +133,9 @@ def train(
         scenarios=tuple((t.scenario.name, t.sha256) for t in scenarios),
         fitness=fitness, baseline=base,
         validation=tuple((t.scenario.name, t.sha256) for t in held_out), validation_baseline=v_base,
-        clearance_m=clearance,
+        clearance_m=clearance, dof=dof,
     )
-    seeds = resolve_seed_rulebooks(seed_rulebook, config.init, config.bounds)
+    seeds = resolve_seed_rulebooks(seed_rulebook, config.init, config.bounds, config.dof)
     config = dataclasses.replace(config, seed_rulebooks=tuple((s.rulebook.name, s.sha256)
                                                               for s in seeds))
     job = TrainJob(config=config, scenarios=scenarios, out=out, resume=resume, workers=workers,

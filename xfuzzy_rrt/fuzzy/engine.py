@@ -1,8 +1,10 @@
 """The compiled zero-order Takagi-Sugeno engine (numba) that the planner loop calls.
 
-Inputs: ``knots`` float64[6, 4, 5] (per FIS, per input, ``[lo, p1, p2, p3, hi]``) and
-``consts`` float64[6, 625] (rule constants, index ``((t0*5 + t1)*5 + t2)*5 + t3``), as made by
-:meth:`xfuzzy_rrt.fuzzy.rulebook.Rulebook.arrays`.
+Inputs: ``knots`` float64[n_out, 4, 5] (per FIS, per input, ``[lo, p1, p2, p3, hi]``) and
+``consts`` float64[n_out, 625] (rule constants, index ``((t0*5 + t1)*5 + t2)*5 + t3``), as made
+by :meth:`xfuzzy_rrt.fuzzy.rulebook.Rulebook.arrays`. ``n_out = knots.shape[0]`` is the
+rulebook's number of FIS: 6 at 2 DOF, ``2N + 2`` for a paper rulebook of N joints. Nothing here
+assumes six; every function loops over ``knots.shape[0]``, so callers size their buffers from it.
 
 Why it is fast without being different: the five terms of every input form a Ruspini
 partition, so an input value lies in one knot segment ``[knots[k], knots[k+1]]`` where only
@@ -17,7 +19,7 @@ propagate to NaN outputs (validate at the boundary, e.g. ``rules eval`` rejects 
 
 Tracing: with ``record=True``, :func:`infer` also writes, per FIS, the rules with non-zero
 strength (ascending index) and their normalised strengths (summing to 1) into the caller's
-``fired_rule`` int32[6, 16] / ``fired_w`` float64[6, 16]; unused slots get -1 and 0.0. The
+``fired_rule`` int32[n_out, 16] / ``fired_w`` float64[n_out, 16]; unused slots get -1 and 0.0. The
 outputs are bit-identical with and without recording (same arithmetic), so turning a trace on
 never changes what a planner does. Recording costs the 16 products and stores per FIS
 (~0.1 µs per six-output call). Nothing allocates.
@@ -79,10 +81,11 @@ def _combine(c, r, a0, b0, a1, b1, a2, b2, a3, b3):
 
 @numba.njit(cache=True, nogil=True)
 def infer(knots, consts, x, out, fired_rule, fired_w, record):
-    """Evaluate all six FIS at input ``x`` (float64[4], INPUTS order) into ``out`` float64[6].
+    """Evaluate every FIS at input ``x`` (float64[4], inputs order) into ``out``
+    float64[n_out] (``n_out = knots.shape[0]``; six at 2 DOF).
 
-    With ``record`` true, also fill ``fired_rule`` int32[6, 16] and ``fired_w`` float64[6, 16]
-    (see the module docstring). Callable from other njit code; no allocation.
+    With ``record`` true, also fill ``fired_rule`` int32[n_out, 16] and ``fired_w``
+    float64[n_out, 16] (see the module docstring). Callable from other njit code; no allocation.
     """
     n_fis = knots.shape[0]
     if not record:  # the planner's normal path: factorised, nothing stored
@@ -163,5 +166,9 @@ def evaluate(knots, consts, X) -> np.ndarray:
 
 
 def new_trace_buffers(n_fis: int = N_OUTPUTS) -> tuple[np.ndarray, np.ndarray]:
-    """``(fired_rule, fired_w)`` buffers of the shapes :func:`infer` fills when recording."""
+    """``(fired_rule, fired_w)`` buffers of the shapes :func:`infer` fills when recording.
+
+    Pass ``knots.shape[0]`` (or ``rulebook.n_outputs``) for a rulebook of another DOF; the
+    default is the 2-DOF six.
+    """
     return np.full((n_fis, MAX_FIRED), -1, dtype=np.int32), np.zeros((n_fis, MAX_FIRED))

@@ -69,6 +69,8 @@ def format_fll(fis: FuzzySystem, rulebook: Rulebook | None = None) -> str:
         meta = {"name": rulebook.name, "bounds_mode": rulebook.bounds_mode, "sha256": rulebook.sha256}
         if rulebook.semantics.name != "paper":
             meta["semantics"] = rulebook.semantics.name
+        if rulebook.dof != _sem.DEFAULT_DOF:  # 2-DOF exports keep their bytes
+            meta["dof"] = rulebook.dof
         lines.append(f"  description: {_DESCRIPTION_TAG} {json.dumps(meta, sort_keys=True)}")
     for inp in fis.inputs:
         lo, p1, p2, p3, hi = inp.peaks
@@ -112,7 +114,7 @@ def format_fll(fis: FuzzySystem, rulebook: Rulebook | None = None) -> str:
 
 
 def export_fll(rulebook: Rulebook, out_dir: str | os.PathLike[str]) -> list[Path]:
-    """Write ``<output>.fll`` for each of the six FIS into *out_dir*; return the paths."""
+    """Write ``<output>.fll`` for each FIS (six at 2 DOF) into *out_dir*; return the paths."""
     texts = {fll_file_name(s.output): format_fll(s, rulebook) for s in rulebook.systems}
     root = write_files(out_dir, texts)
     return [root / name for name in texts]
@@ -250,7 +252,7 @@ def parse_fll(data: bytes, file: str, expected_output: str,
         if v is None:
             continue
         check_range(v, sem.input_ranges[name])
-        part = _partition(v, problem)
+        part = _partition(v, problem, sem)
         if part is not None:
             partitions[name] = part
 
@@ -317,11 +319,12 @@ def parse_fll(data: bytes, file: str, expected_output: str,
         output=expected_output,
         inputs=tuple(partitions[name] for name in sem.inputs),
         consts=tuple(consts),
+        dof=sem.dof,
     )
     return fis, meta, []
 
 
-def _partition(v: _Var, problem) -> InputPartition | None:
+def _partition(v: _Var, problem, sem: "_sem.Semantics") -> InputPartition | None:
     """The five terms of an input as a Ruspini partition, or ``None`` (problems reported)."""
     if len(v.terms) != N_TERMS:
         problem(v.line, f"{v.name}: expected {N_TERMS} terms, got {len(v.terms)}")
@@ -339,7 +342,7 @@ def _partition(v: _Var, problem) -> InputPartition | None:
             return None
         shapes.append((shape[1], shape, tname, n))
     shapes.sort(key=lambda s: s[0])
-    lo, hi = _sem.ALL_INPUT_RANGES[v.name]
+    lo, hi = sem.input_ranges[v.name]
     peaks = [s[0] for s in shapes]
     # infinite shoulders: -inf / +inf feet are fine at the ends
     problem_text = peaks_problem(tuple(peaks), lo, hi)
@@ -354,7 +357,42 @@ def _partition(v: _Var, problem) -> InputPartition | None:
         if not (ok_left and ok_right):
             problem(n, f"term {tname!r} does not fit a Ruspini partition (feet must be the neighbouring peaks)")
             return None
-    return InputPartition(name=v.name, terms=tuple(s[2] for s in shapes), peaks=tuple(peaks))
+    return InputPartition(name=v.name, terms=tuple(s[2] for s in shapes), peaks=tuple(peaks),
+                          dof=sem.dof)
+
+
+_BOUND_FLL = re.compile(r"bound_([1-9][0-9]*)\Z")
+
+
+def _infer_dof(root: Path, sem: "_sem.Semantics", problems: list) -> int:
+    """The DOF of the engines in *root* (2 when nothing says otherwise; problems reported).
+
+    Paper: the ``bound_K.fll`` files present must be exactly ``bound_1 … bound_2N`` for one N.
+    Goal-frame: ``joint_dist_to_goal``'s range in ``goal_bias.fll`` is ``[0, 180*sqrt(2N)]``.
+    """
+    if sem.name == _sem.PAPER.name:
+        bounds = sorted((p.stem for p in root.glob("bound_*" + FLL_SUFFIX) if _BOUND_FLL.match(p.stem)),
+                        key=lambda b: int(_BOUND_FLL.match(b).group(1)))
+        dof = _sem.dof_of_outputs(sem.name, [sem.outputs[0], *bounds, sem.outputs[-1]])
+        if dof is None:
+            problems.append((str(root), None, f"bound files {', '.join(bounds) or '(none)'} fit no "
+                             f"DOF: an arm of N joints needs bound_1{FLL_SUFFIX} \u2026 "
+                             f"bound_2N{FLL_SUFFIX} (N = {_sem.MIN_DOF}..{_sem.MAX_DOF})"))
+            return _sem.DEFAULT_DOF
+        return dof
+    name = sem.inputs[0]
+    if name != "joint_dist_to_goal":  # pragma: no cover - only goal-frame has DOF-free outputs
+        return _sem.DEFAULT_DOF
+    try:
+        text = (root / fll_file_name(sem.outputs[0])).read_text("utf-8", errors="replace")
+    except OSError:
+        return _sem.DEFAULT_DOF  # the missing file is reported by the caller
+    m = re.search(r"InputVariable:\s*" + name + r"\s*\n(?:[^\n]*\n)*?\s*range:\s*(\S+)\s+(\S+)", text)
+    got = (_float(m.group(1)), _float(m.group(2))) if m else None
+    for d in range(_sem.MIN_DOF, _sem.MAX_DOF + 1):
+        if sem.for_dof(d).input_ranges[name] == got:
+            return d
+    return _sem.DEFAULT_DOF  # a wrong range is reported by parse_fll, against the 2-DOF one
 
 
 def import_fll(
@@ -364,11 +402,13 @@ def import_fll(
     bounds_mode: str | None = None,
     command: str | None = None,
 ) -> Rulebook:
-    """Read ``<output>.fll`` for all six outputs from *fll_dir* into a :class:`Rulebook`.
+    """Read ``<output>.fll`` for every output from *fll_dir* into a :class:`Rulebook`.
 
     Name and bounds mode come from the export's description line unless given; otherwise the
-    directory name and ``"absolute"`` (the paper's reading). Raises :class:`RulebookError` with
-    every problem found.
+    directory name and ``"absolute"`` (the paper's reading). The DOF comes from the files: for
+    the paper's semantics from the output names (``bound_1.fll … bound_2N.fll``), for
+    goal-frame (whose outputs do not depend on it) from the range of ``joint_dist_to_goal``.
+    Raises :class:`RulebookError` with every problem found.
     """
     root = Path(fll_dir)
     if not root.is_dir():
@@ -380,6 +420,7 @@ def import_fll(
     # is shared); the export's description line says it too
     sem = next((s for s in _sem.SEMANTICS.values() if (root / fll_file_name(s.outputs[1])).is_file()),
                _sem.PAPER)
+    sem = sem.for_dof(_infer_dof(root, sem, problems))
     for output in sem.outputs:
         file = root / fll_file_name(output)
         try:
@@ -394,7 +435,7 @@ def import_fll(
     if problems:
         raise RulebookError(problems)
     mode = bounds_mode or meta.get("bounds_mode") or "absolute"
-    if sem is not _sem.PAPER:
+    if sem.name != _sem.PAPER.name:
         mode = None
     elif mode not in ("absolute", "relative"):
         raise RulebookError([(str(root), None, f"bounds mode must be absolute or relative, got {mode!r}")])

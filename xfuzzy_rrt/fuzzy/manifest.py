@@ -22,6 +22,11 @@ Example::
 
 ``bounds_mode`` says how the four bound outputs are meant: ``"absolute"`` joint limits in
 degrees (the paper's reading) or ``"relative"`` offsets from the current nearest tree node.
+``dof`` (an integer 2..7, the arm's joints) is written only when it is not 2, so every 2-DOF
+manifest keeps its bytes and its SHA-256; a missing key means 2. It fixes the FIS files the
+directory must hold (see :mod:`.semantics`: a paper rulebook of ``dof = 5`` has
+``bound_1.fis … bound_10.fis``).
+
 ``provenance`` records what produced the rulebook: at least ``kind`` (e.g. ``"hand-written"``,
 ``"ga"``, ``"imported-fll"``), typically also ``command``, ``seed``, ``fitness``,
 ``scenarios`` and ``date``. Any TOML value is allowed there.
@@ -45,7 +50,7 @@ MANIFEST_NAME = "rulebook.toml"
 FORMAT_NAME = "xfuzzy-rrt-rulebook"
 FORMAT_VERSION = 1
 BOUNDS_MODES = ("absolute", "relative")
-TOP_KEYS = ("format", "format_version", "name", "semantics", "bounds_mode", "description")
+TOP_KEYS = ("format", "format_version", "name", "semantics", "dof", "bounds_mode", "description")
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+\Z")
 
 Problem = tuple[str, "int | None", str]
@@ -78,11 +83,12 @@ class Manifest:
     provenance: Mapping[str, Any] = field(default_factory=dict)
     description: str = ""
     semantics: str = "paper"
+    dof: int = _sem.DEFAULT_DOF
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
             raise ValueError("rulebook name must be a non-empty string")
-        _sem.get(self.semantics)  # raises ValueError when unknown
+        _sem.get(self.semantics, self.dof)  # raises ValueError when unknown or a bad dof
         if self.semantics == _sem.PAPER.name:
             if self.bounds_mode not in BOUNDS_MODES:
                 raise ValueError(f"bounds_mode must be one of {BOUNDS_MODES}, got {self.bounds_mode!r}")
@@ -174,19 +180,26 @@ def _toml_table_lines(path: list[str], table: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+_COUNT_WORDS = {6: "six", 8: "eight", 10: "ten", 12: "twelve", 14: "fourteen", 16: "sixteen"}
+
+
 def format_manifest(m: Manifest) -> str:
-    """Canonical text of a manifest (``semantics`` is written only when it is not the paper's,
-    so every paper-semantics rulebook keeps its bytes and its SHA-256)."""
-    outputs = _sem.get(m.semantics).outputs
+    """Canonical text of a manifest (``semantics`` is written only when it is not the paper's
+    and ``dof`` only when it is not 2, so every 2-DOF paper-semantics rulebook keeps its bytes
+    and its SHA-256)."""
+    outputs = _sem.get(m.semantics, m.dof).outputs
     first, last = outputs[0], outputs[-1]
+    count = _COUNT_WORDS.get(len(outputs), str(len(outputs)))
     lines = [
-        f"# xfuzzy-rrt rulebook manifest; the six FIS files ({first}{SUFFIX} ... {last}{SUFFIX}) sit beside it.",
+        f"# xfuzzy-rrt rulebook manifest; the {count} FIS files ({first}{SUFFIX} ... {last}{SUFFIX}) sit beside it.",
         f"format = {_toml_string(FORMAT_NAME)}",
         f"format_version = {FORMAT_VERSION}",
         f"name = {_toml_string(m.name)}",
     ]
     if m.semantics != _sem.PAPER.name:
         lines.append(f"semantics = {_toml_string(m.semantics)}")
+    if m.dof != _sem.DEFAULT_DOF:
+        lines.append(f"dof = {m.dof}")
     if m.bounds_mode is not None:
         lines.append(f"bounds_mode = {_toml_string(m.bounds_mode)}")
     if m.description:
@@ -269,6 +282,11 @@ def parse_manifest(data: bytes, file: str) -> tuple[Manifest | None, list[Proble
     if sem_name not in _sem.SEMANTICS:
         problem("semantics", f"semantics must be one of {', '.join(map(repr, _sem.SEMANTICS))}, got {sem_name!r}")
         sem_name = _sem.PAPER.name
+    dof = doc.get("dof", _sem.DEFAULT_DOF)
+    dof_problem = _sem.dof_problem(dof)
+    if dof_problem:
+        problem("dof", dof_problem)
+        dof = _sem.DEFAULT_DOF
     mode = doc.get("bounds_mode")
     if sem_name != _sem.PAPER.name:
         if mode is not None:
@@ -296,4 +314,4 @@ def parse_manifest(data: bytes, file: str) -> tuple[Manifest | None, list[Proble
     if problems:
         return None, problems
     return Manifest(name=name, bounds_mode=mode, provenance=prov, description=description,
-                    semantics=sem_name), []
+                    semantics=sem_name, dof=dof), []

@@ -2,9 +2,9 @@
 
 On disk a rulebook is a directory::
 
-    rulebook.toml      manifest: name, format version, bounds mode, provenance (see .manifest)
+    rulebook.toml      manifest: name, format version, semantics, dof, bounds mode, provenance
     goal_bias.fis      one text file per output FIS (see .text_format)
-    bound_1.fis ... bound_4.fis
+    bound_1.fis ... bound_4.fis     (paper semantics: bound_1 ... bound_2N for dof = N)
     step_size.fis
 
 Other files in the directory (e.g. a trainer's ``history.csv``) are left alone; an unknown
@@ -15,7 +15,7 @@ with *all* problems as ``(file, line, message)``. :func:`save_rulebook` writes t
 text; a canonical directory loads and saves back to identical bytes.
 
 ``Rulebook.sha256`` identifies a rulebook in results: the SHA-256 over the canonical bytes of
-the manifest and the six FIS files, in the order ``rulebook.toml``, then OUTPUTS order, each
+the manifest and the FIS files, in the order ``rulebook.toml``, then output order, each
 fed as ``<file name>\\n<byte length>\\n<bytes>`` (so file boundaries are unambiguous). For a
 canonical directory (every shipped or saved one) these are exactly the bytes on disk; a
 hand-edited file with extra comments hashes as its canonical form, i.e. comments do not change
@@ -28,6 +28,7 @@ import errno
 import functools
 import hashlib
 import os
+import re
 import tempfile
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -41,13 +42,14 @@ from xfuzzy_rrt.fuzzy.manifest import (
     BOUNDS_MODES,
     MANIFEST_NAME,
     Manifest,
+    _key_line,
     format_manifest,
     parse_manifest,
 )
 from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.fuzzy.system import FuzzySystem, InputPartition
 from xfuzzy_rrt.fuzzy.text_format import SUFFIX, format_fis, parse_fis
-from xfuzzy_rrt.fuzzy.variables import N_INPUTS, N_OUTPUTS, N_RULES, N_TERMS
+from xfuzzy_rrt.fuzzy.variables import N_INPUTS, N_RULES, N_TERMS
 
 #: Environment variable naming a folder of rulebooks that replaces the shipped one.
 RULEBOOKS_ENV = "XFUZZY_RRT_RULEBOOKS"
@@ -76,11 +78,12 @@ def fis_file_name(output: str) -> str:
 
 @dataclass(frozen=True)
 class Rulebook:
-    """Six single-output TSK systems (the semantics' output order) with a name, semantics,
+    """Single-output TSK systems (the semantics' output order) with a name, semantics,
     bounds mode (paper semantics only; ``None`` otherwise) and provenance.
 
     ``semantics`` is a :class:`~.semantics.Semantics` (or its name): it fixes the input and
-    output names, ranges and units every tool reads.
+    output names, ranges and units every tool reads, and carries the rulebook's DOF
+    (:attr:`dof`). A name alone means the DOF of the systems (2 when there are none).
     """
 
     name: str
@@ -91,13 +94,14 @@ class Rulebook:
     semantics: "_sem.Semantics | str | None" = None  # None: the systems' own semantics
 
     def __post_init__(self) -> None:
+        first = self.systems[0] if len(self.systems) else None
+        dof = first.dof if isinstance(first, FuzzySystem) else _sem.DEFAULT_DOF
         if self.semantics is None:
-            first = self.systems[0] if len(self.systems) else None
             sem = first.semantics if isinstance(first, FuzzySystem) else _sem.PAPER
         elif isinstance(self.semantics, _sem.Semantics):
             sem = self.semantics
         else:
-            sem = _sem.get(self.semantics)
+            sem = _sem.get(self.semantics, dof)
         object.__setattr__(self, "semantics", sem)
         object.__setattr__(self, "systems", tuple(self.systems))
         for s in self.systems:
@@ -105,11 +109,13 @@ class Rulebook:
                 raise ValueError(f"systems must be FuzzySystem objects, got {type(s).__name__}")
         outputs = tuple(s.output for s in self.systems)
         if outputs != sem.outputs or any(s.semantics is not sem for s in self.systems):
-            raise ValueError(f"systems must be {sem.outputs} of the {sem.name} semantics in that "
-                             f"order, got {outputs}")
+            raise ValueError(f"systems must be {sem.outputs} of the {sem.name} semantics at dof "
+                             f"{sem.dof} in that order, got {outputs} (dof "
+                             f"{sorted({s.dof for s in self.systems})})")
         manifest = Manifest(
             name=self.name, bounds_mode=self.bounds_mode,
             provenance=self.provenance, description=self.description, semantics=sem.name,
+            dof=sem.dof,
         )  # validates; also freezes provenance
         object.__setattr__(self, "provenance", manifest.provenance)
 
@@ -119,7 +125,7 @@ class Rulebook:
         from xfuzzy_rrt.fuzzy.manifest import thaw
 
         return (_rebuild, (self.name, self.bounds_mode, self.systems, thaw(self.provenance),
-                           self.description, self.semantics.name))
+                           self.description, self.semantics.name, self.semantics.dof))
 
     # ------------------------------------------------------------------ views
 
@@ -128,8 +134,22 @@ class Rulebook:
         return Manifest(
             name=self.name, bounds_mode=self.bounds_mode,
             provenance=self.provenance, description=self.description,
-            semantics=self.semantics.name,
+            semantics=self.semantics.name, dof=self.semantics.dof,
         )
+
+    @property
+    def dof(self) -> int:
+        """The arm's degrees of freedom this rulebook is for (2..7; manifest key ``dof``).
+
+        For the paper semantics, the DOF of each arm (the box has 2 bounds per joint); for
+        goal-frame, the total joints planned together.
+        """
+        return self.semantics.dof
+
+    @property
+    def n_outputs(self) -> int:
+        """Number of FIS: the first axis of the compiled ``knots``/``consts``."""
+        return len(self.systems)
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -149,7 +169,7 @@ class Rulebook:
             raise KeyError(f"unknown output {output!r}; outputs are {self.outputs}") from None
 
     def texts(self, compact: bool = False) -> dict[str, str]:
-        """Canonical text of every file, keyed by file name (manifest first, then OUTPUTS).
+        """Canonical text of every file, keyed by file name (manifest first, then outputs).
 
         ``compact=True`` writes the FIS files with ``any`` rules (same constants, fewer lines;
         see :mod:`.text_format`); ``sha256`` always hashes the default full form.
@@ -174,7 +194,7 @@ class Rulebook:
         """Read-only engine arrays, built once per rulebook (what the planners use).
 
         A rulebook is immutable, so planning with the same object many times (the Python API,
-        benchmarks) must not rebuild 3,750 constants per call.
+        benchmarks) must not rebuild 3,750 (at 2 DOF) constants per call.
         """
         knots, consts = self.arrays()
         knots.setflags(write=False)
@@ -182,9 +202,11 @@ class Rulebook:
         return knots, consts
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray]:
-        """Fresh C-contiguous ``(knots float64[6, 4, 5], consts float64[6, 625])`` for the engine."""
-        knots = np.empty((N_OUTPUTS, N_INPUTS, N_TERMS), dtype=np.float64)
-        consts = np.empty((N_OUTPUTS, N_RULES), dtype=np.float64)
+        """Fresh C-contiguous ``(knots float64[n_out, 4, 5], consts float64[n_out, 625])`` for
+        the engine, ``n_out = len(self.outputs)`` (6 at 2 DOF; 2N + 2 for the paper's at N)."""
+        n_out = len(self.systems)
+        knots = np.empty((n_out, N_INPUTS, N_TERMS), dtype=np.float64)
+        consts = np.empty((n_out, N_RULES), dtype=np.float64)
         for f, s in enumerate(self.systems):
             for i, inp in enumerate(s.inputs):
                 knots[f, i, :] = inp.peaks
@@ -205,40 +227,51 @@ class Rulebook:
         description: str = "",
         term_names: Mapping[str, tuple[str, ...]] | None = None,
         semantics: "_sem.Semantics | str" = _sem.PAPER,
+        dof: int | None = None,
     ) -> "Rulebook":
         """Build a rulebook from engine arrays (what the GA trainer evolves).
 
         ``knots[f, i]`` must be ``[lo, p1, p2, p3, hi]`` with the input's exact range ends and
         strictly increasing peaks; ``consts`` must lie within each output's range (clip them
-        before calling). Term names default to :data:`~.variables.DEFAULT_TERMS`. Raises
+        before calling). Term names default to :data:`~.variables.DEFAULT_TERMS`. The DOF is
+        *dof* if given, else that of *semantics* (a :class:`~.semantics.Semantics` carries
+        one; a name means 2); the arrays must have ``len(outputs)`` rows at that DOF. Raises
         ``ValueError`` naming the offending FIS, input or rule.
         """
         knots = np.asarray(knots, dtype=np.float64)
         consts = np.asarray(consts, dtype=np.float64)
-        if knots.shape != (N_OUTPUTS, N_INPUTS, N_TERMS):
-            raise ValueError(f"knots must have shape {(N_OUTPUTS, N_INPUTS, N_TERMS)}, got {knots.shape}")
-        if consts.shape != (N_OUTPUTS, N_RULES):
-            raise ValueError(f"consts must have shape {(N_OUTPUTS, N_RULES)}, got {consts.shape}")
         sem = semantics if isinstance(semantics, _sem.Semantics) else _sem.get(semantics)
+        if dof is not None:
+            sem = sem.for_dof(dof)
+        n_out = len(sem.outputs)
+        if knots.shape != (n_out, N_INPUTS, N_TERMS):
+            raise ValueError(f"knots must have shape {(n_out, N_INPUTS, N_TERMS)} ({sem.name} "
+                             f"semantics at dof {sem.dof}), got {knots.shape}")
+        if consts.shape != (n_out, N_RULES):
+            raise ValueError(f"consts must have shape {(n_out, N_RULES)} ({sem.name} semantics "
+                             f"at dof {sem.dof}), got {consts.shape}")
         names = dict(sem.default_terms)
         if term_names:
             names.update({k: tuple(v) for k, v in term_names.items()})
         systems = []
         for f, output in enumerate(sem.outputs):
             inputs = tuple(
-                InputPartition(name=inp, terms=names[inp], peaks=tuple(knots[f, i].tolist()))
+                InputPartition(name=inp, terms=names[inp], peaks=tuple(knots[f, i].tolist()),
+                               dof=sem.dof)
                 for i, inp in enumerate(sem.inputs)
             )
-            systems.append(FuzzySystem(output=output, inputs=inputs, consts=tuple(consts[f].tolist())))
+            systems.append(FuzzySystem(output=output, inputs=inputs,
+                                       consts=tuple(consts[f].tolist()), dof=sem.dof))
         return cls(
             name=name, bounds_mode=bounds_mode, systems=tuple(systems),
             provenance=dict(provenance or {}), description=description, semantics=sem,
         )
 
 
-def _rebuild(name, bounds_mode, systems, provenance, description, semantics="paper") -> "Rulebook":
+def _rebuild(name, bounds_mode, systems, provenance, description, semantics="paper",
+             dof=_sem.DEFAULT_DOF) -> "Rulebook":
     return Rulebook(name=name, bounds_mode=bounds_mode, systems=systems, provenance=provenance,
-                    description=description, semantics=semantics)
+                    description=description, semantics=_sem.get(semantics, dof))
 
 
 # ------------------------------------------------------------------------- locations
@@ -339,32 +372,40 @@ def load_rulebook(path: str | os.PathLike[str]) -> Rulebook:
     if not root.is_dir():
         raise RulebookError([(str(root), None, "not a directory (a rulebook is a directory)")])
     problems: list[tuple[str, int | None, str]] = []
-    all_outputs = {o for s in _sem.SEMANTICS.values() for o in s.outputs}
-    expected = [MANIFEST_NAME, *(fis_file_name(o) for o in sorted(all_outputs))]
-    if not any((root / name).exists() for name in expected):
+    try:
+        fis_stems = {p.stem for p in root.iterdir() if p.suffix == SUFFIX}
+    except OSError as exc:
+        raise RulebookError([(str(root), None, f"cannot list directory: {exc.strerror or exc}")]) from None
+    known = {o for s in _sem.SEMANTICS.values()
+             for d in range(_sem.MIN_DOF, _sem.MAX_DOF + 1) for o in _sem.get(s.name, d).outputs}
+    if not (fis_stems & known) and not (root / MANIFEST_NAME).exists():
         # Not a damaged rulebook but no rulebook at all: one line, not seven "missing file"s.
         raise RulebookError([(str(root), None, f"not a rulebook directory (no {MANIFEST_NAME} "
                               f"and no {SUFFIX} files)")])
     manifest = None
+    dof_line = None
     data = _read(root / MANIFEST_NAME, problems)
     if data is not None:
         manifest, found = parse_manifest(data, str(root / MANIFEST_NAME))
         problems.extend(found)
-    sem = _sem.get(manifest.semantics) if manifest is not None else _sem.PAPER
-    try:
-        extra = sorted(
-            p.name for p in root.iterdir()
-            if p.suffix == SUFFIX and p.stem not in sem.outputs
-        )
-    except OSError as exc:
-        raise RulebookError([(str(root), None, f"cannot list directory: {exc.strerror or exc}")]) from None
-    for name in extra:
+        if manifest is not None:
+            dof_line = _key_line(data.decode("utf-8").splitlines(), "dof")
+    if manifest is not None:
+        sem = _sem.get(manifest.semantics, manifest.dof)
+    else:  # the manifest's own problems are reported; read the files as what they look like
+        sem = _sem.PAPER.for_dof(_sem.dof_of_outputs(_sem.PAPER.name, fis_stems) or _sem.DEFAULT_DOF)
+    skip: set[str] = set()
+    if sem.name == _sem.PAPER.name:
+        skip = _check_bound_files(sem, fis_stems, str(root / MANIFEST_NAME), dof_line, problems)
+    for stem in sorted(fis_stems - set(sem.outputs) - skip):
         problems.append(
-            (str(root / name), None, f"unexpected FIS file (the {sem.name} semantics' outputs "
-                                     f"are {', '.join(sem.outputs)})")
+            (str(root / fis_file_name(stem)), None, f"unexpected FIS file (the {sem.name} "
+                                                    f"semantics' outputs are {', '.join(sem.outputs)})")
         )
     systems = []
     for output in sem.outputs:
+        if output in skip:
+            continue
         file = root / fis_file_name(output)
         data = _read(file, problems)
         if data is None:
@@ -378,6 +419,45 @@ def load_rulebook(path: str | os.PathLike[str]) -> Rulebook:
         name=manifest.name, bounds_mode=manifest.bounds_mode, systems=tuple(systems),
         provenance=manifest.provenance, description=manifest.description, semantics=sem,
     )
+
+
+_BOUND_FILE = re.compile(r"bound_([1-9][0-9]*)\Z")
+
+
+def _file_run(stems: list[str]) -> str:
+    """``bound_5.fis … bound_10.fis`` for a consecutive run of bound files, else a list."""
+    nums = [int(_BOUND_FILE.match(s).group(1)) for s in stems]
+    if len(nums) > 2 and nums == list(range(nums[0], nums[0] + len(nums))):
+        return f"{fis_file_name(stems[0])} \u2026 {fis_file_name(stems[-1])}"
+    return ", ".join(fis_file_name(s) for s in stems)
+
+
+def _check_bound_files(sem: "_sem.Semantics", stems: set[str], manifest_file: str,
+                       dof_line: int | None, problems: list) -> set[str]:
+    """Compare the ``bound_K.fis`` files present with those the declared DOF needs.
+
+    Why one line in the manifest rather than one per file: a wrong or missing ``dof`` key is
+    the usual cause, and it is the manifest that must be fixed (or the files). Returns the
+    bound stems already reported (missing or extra), which the caller then skips.
+    """
+    want = _sem.bound_outputs(sem.dof)
+    have = sorted((s for s in stems if _BOUND_FILE.match(s)),
+                  key=lambda s: int(_BOUND_FILE.match(s).group(1)))
+    missing = [b for b in want if b not in stems]
+    extra = [b for b in have if b not in want]
+    if not (missing or extra):
+        return set()
+    declared = f"dof = {sem.dof}" if dof_line is not None else f"dof = {sem.dof} (no dof key)"
+    parts = []
+    if missing:
+        parts.append(f"{_file_run(missing)} {'is' if len(missing) == 1 else 'are'} missing")
+    if extra:
+        parts.append(f"{_file_run(extra)} {'is' if len(extra) == 1 else 'are'} extra")
+    fits = _sem.dof_of_outputs(sem.name, [o for o in sem.outputs if o not in want] + have)
+    hint = f" (the files present fit dof = {fits})" if fits is not None and fits != sem.dof else ""
+    problems.append((manifest_file, dof_line,
+                     f"{declared} needs {_file_run(list(want))}; {'; '.join(parts)}{hint}"))
+    return set(missing) | set(extra)
 
 
 def save_rulebook(rulebook: Rulebook, path: str | os.PathLike[str], compact: bool = False) -> Path:

@@ -27,6 +27,19 @@ a non-goal sample is drawn uniformly over the whole joint space: the escape from
 from it), ``side_deg`` (half-width across it) and ``step_deg`` (extension step). Because
 every quantity is relative to the problem's own start, goal and obstacles in joint space, one
 rulebook transfers between problems.
+
+Degrees of freedom. A rulebook declares its arm's DOF ``N`` (2..7; manifest key ``dof``, absent
+means 2). :func:`get` (or :meth:`Semantics.for_dof`) gives the semantics at that DOF; at ``N = 2``
+it returns the very objects :data:`PAPER` and :data:`GOAL_FRAME`, so nothing about a 2-DOF
+rulebook changes. What depends on ``N``:
+
+- ``paper``: the joint box has one interval per joint, so the outputs are ``goal_bias,
+  bound_1 … bound_2N, step_size`` (``bound_2j-1``/``bound_2j`` = joint ``j``'s interval);
+  2N + 2 FIS. Inputs and ranges are unchanged (they are workspace quantities).
+- ``goal-frame``: the same six outputs (the box is laid along the joint-space direction, whatever
+  its dimension); only ``joint_dist_to_goal``'s range grows to ``[0, 180*sqrt(2N)]`` degrees,
+  the diagonal of a joint space of N joints of 360° each (scaled so that N = 2 gives exactly
+  the 360 it always had). For several arms, N is the total number of joints planned together.
 """
 
 from __future__ import annotations
@@ -41,7 +54,12 @@ from xfuzzy_rrt.fuzzy import variables as _paper
 
 @dataclass(frozen=True)
 class Semantics:
-    """Names, ranges, units and default terms of one rulebook semantics (4 inputs, 6 outputs)."""
+    """Names, ranges, units and default terms of one rulebook semantics at one DOF.
+
+    Always four inputs; the outputs depend on the semantics and the DOF (``len(outputs)`` is
+    the number of FIS, the first axis of the compiled arrays). Instances are shared: get them
+    from :func:`get` / :meth:`for_dof`, and compare them with ``is``.
+    """
 
     name: str
     inputs: tuple[str, ...]
@@ -52,6 +70,16 @@ class Semantics:
     default_terms: Mapping[str, tuple[str, ...]]
     default_peaks: Mapping[str, tuple[float, float, float]]
     summary: str
+    dof: int = 2
+
+    @property
+    def n_outputs(self) -> int:
+        """Number of FIS (and first axis of ``knots``/``consts``) at this DOF."""
+        return len(self.outputs)
+
+    def for_dof(self, dof: int) -> "Semantics":
+        """This semantics at *dof* joints (the same cached object for the same DOF)."""
+        return get(self.name, dof)
 
     def default_knots(self, name: str) -> tuple[float, float, float, float, float]:
         """``(lo, p1, p2, p3, hi)`` for input *name* with the default peaks."""
@@ -114,26 +142,109 @@ ALL_INPUT_RANGES: Mapping[str, tuple[float, float]] = _ro(
     {n: r for s in SEMANTICS.values() for n, r in s.input_ranges.items()})
 
 
-def get(name: str | None) -> Semantics:
-    """The semantics called *name* (``None``: the paper's); ``ValueError`` when unknown."""
+MIN_DOF = 2
+MAX_DOF = 7
+DEFAULT_DOF = 2
+
+
+def dof_problem(dof) -> str | None:
+    """Why *dof* is not a valid degree of freedom (``None`` when it is): an ``int`` 2..7."""
+    if type(dof) is not int or not MIN_DOF <= dof <= MAX_DOF:
+        return f"dof must be an integer from {MIN_DOF} to {MAX_DOF} (the arm's joints), got {dof!r}"
+    return None
+
+
+def bound_outputs(dof: int) -> tuple[str, ...]:
+    """``bound_1 … bound_{2*dof}`` of the paper's semantics (two per joint)."""
+    return tuple(f"bound_{k}" for k in range(1, 2 * dof + 1))
+
+
+def joint_dist_range(dof: int) -> tuple[float, float]:
+    """Range of ``joint_dist_to_goal`` at *dof* joints: ``[0, 180*sqrt(2*dof)]`` degrees.
+
+    ``sqrt(4) == 2.0`` exactly, so the 2-DOF range is exactly the ``[0, 360]`` of the files.
+    """
+    return (0.0, 180.0 * math.sqrt(2 * dof))
+
+
+def _paper_at(dof: int) -> Semantics:
+    bounds = bound_outputs(dof)
+    outputs = ("goal_bias", *bounds, "step_size")
+    ranges = {"goal_bias": PAPER.output_ranges["goal_bias"],
+              **{b: PAPER.output_ranges["bound_1"] for b in bounds},
+              "step_size": PAPER.output_ranges["step_size"]}
+    units = {**{n: PAPER.units[n] for n in PAPER.inputs}, "goal_bias": "",
+             **{b: "deg" for b in bounds}, "step_size": "deg"}
+    return Semantics(
+        name=PAPER.name, inputs=PAPER.inputs, outputs=outputs, input_ranges=PAPER.input_ranges,
+        output_ranges=_ro(ranges), units=_ro(units), default_terms=PAPER.default_terms,
+        default_peaks=PAPER.default_peaks, summary=f"{PAPER.summary} ({dof} joints)", dof=dof,
+    )
+
+
+def _goal_frame_at(dof: int) -> Semantics:
+    ranges = dict(GOAL_FRAME.input_ranges)
+    ranges["joint_dist_to_goal"] = joint_dist_range(dof)
+    return Semantics(
+        name=GOAL_FRAME.name, inputs=GOAL_FRAME.inputs, outputs=GOAL_FRAME.outputs,
+        input_ranges=_ro(ranges), output_ranges=GOAL_FRAME.output_ranges,
+        units=GOAL_FRAME.units, default_terms=GOAL_FRAME.default_terms,
+        default_peaks=GOAL_FRAME.default_peaks,
+        summary=f"{GOAL_FRAME.summary} ({dof} joints in all)", dof=dof,
+    )
+
+
+_BUILDERS = {PAPER.name: _paper_at, GOAL_FRAME.name: _goal_frame_at}
+#: (name, dof) -> Semantics; 2-DOF entries are the module constants themselves.
+_CACHE: dict[tuple[str, int], Semantics] = {(s.name, DEFAULT_DOF): s for s in (PAPER, GOAL_FRAME)}
+
+
+def get(name: str | None, dof: int = DEFAULT_DOF) -> Semantics:
+    """The semantics called *name* (``None``: the paper's) at *dof* joints.
+
+    ``ValueError`` when the name is unknown or *dof* is not an integer 2..7. Instances are
+    cached, so ``get(n, d) is get(n, d)``, and ``get(n, 2)`` is :data:`PAPER`/:data:`GOAL_FRAME`.
+    """
     if name is None:
-        return DEFAULT
-    try:
-        return SEMANTICS[name]
-    except KeyError:
-        raise ValueError(f"unknown semantics {name!r} (known: {', '.join(SEMANTICS)})") from None
+        name = DEFAULT.name
+    if name not in SEMANTICS:
+        raise ValueError(f"unknown semantics {name!r} (known: {', '.join(SEMANTICS)})")
+    problem = dof_problem(dof)
+    if problem:
+        raise ValueError(problem)
+    key = (name, dof)
+    sem = _CACHE.get(key)
+    if sem is None:
+        sem = _CACHE[key] = _BUILDERS[name](dof)
+    return sem
 
 
-def of_inputs(first_input: str) -> Semantics | None:
-    """The semantics whose first input is *first_input* (how a lone FIS file is placed)."""
+def input_range(name: str, dof: int = DEFAULT_DOF) -> tuple[float, float]:
+    """Range of input *name* (of any semantics) at *dof* joints; ``KeyError`` when unknown."""
+    sem = of_input(name)
+    if sem is None:
+        raise KeyError(name)
+    return get(sem.name, dof).input_ranges[name]
+
+
+def dof_of_outputs(name: str, outputs) -> int | None:
+    """The DOF whose output names are exactly *outputs* (any order) for semantics *name*, or
+    ``None`` (none fits, or the outputs do not depend on the DOF, as in goal-frame)."""
+    wanted = set(outputs)
+    fits = [d for d in range(MIN_DOF, MAX_DOF + 1) if set(get(name, d).outputs) == wanted]
+    return fits[0] if len(fits) == 1 else None
+
+
+def of_inputs(first_input: str, dof: int = DEFAULT_DOF) -> Semantics | None:
+    """The semantics (at *dof*) whose first input is *first_input* (how a lone FIS is placed)."""
     for s in SEMANTICS.values():
         if s.inputs[0] == first_input:
-            return s
+            return get(s.name, dof)
     return None
 
 
 def of_input(name: str) -> Semantics | None:
-    """The semantics that has an input called *name*."""
+    """The (2-DOF) semantics that has an input called *name* (input names are unique)."""
     for s in SEMANTICS.values():
         if name in s.inputs:
             return s
@@ -147,9 +258,16 @@ def unit_suffix(sem: Semantics, name: str) -> str:
 
 
 def _check() -> None:
-    for s in SEMANTICS.values():
-        if len(s.inputs) != _paper.N_INPUTS or len(s.outputs) != _paper.N_OUTPUTS:
-            raise RuntimeError(f"semantics {s.name}: must have 4 inputs and 6 outputs")
+    for base in SEMANTICS.values():
+        for dof in range(MIN_DOF, MAX_DOF + 1):
+            s = get(base.name, dof)
+            want = 2 * dof + 2 if s.name == PAPER.name else _paper.N_OUTPUTS
+            if len(s.inputs) != _paper.N_INPUTS or len(s.outputs) != want:
+                raise RuntimeError(f"semantics {s.name} at dof {dof}: must have 4 inputs and "
+                                   f"{want} outputs")
+            if set(s.output_ranges) != set(s.outputs) or set(s.input_ranges) != set(s.inputs):
+                raise RuntimeError(f"semantics {s.name} at dof {dof}: ranges do not match names")
+        s = base
         for n in s.inputs:
             lo, hi = s.input_ranges[n]
             p = s.default_peaks[n]
@@ -161,9 +279,15 @@ _check()
 
 
 def of_columns(columns) -> Semantics:
-    """The semantics whose inputs name columns of a trace or table (the paper's by default)."""
-    cols = set(columns)
-    for s in SEMANTICS.values():
-        if s.inputs[0] in cols:
-            return s
-    return DEFAULT
+    """The semantics whose inputs name columns of a trace or table (the paper's by default),
+    at the DOF its output columns show (``bound_1 … bound_2N``; goal-frame's outputs do not
+    depend on the DOF, so it comes back at 2 there, with the same output names)."""
+    cols = {str(c) for c in columns}
+    base = next((s for s in SEMANTICS.values() if s.inputs[0] in cols), DEFAULT)
+    if base.name == PAPER.name:
+        k = 4
+        while f"bound_{k + 1}" in cols:
+            k += 1
+        if k % 2 == 0 and MIN_DOF <= k // 2 <= MAX_DOF:
+            return get(base.name, k // 2)
+    return base

@@ -56,16 +56,23 @@ class InputPartition:
 
     ``peaks`` is the knot row ``[lo, p1, p2, p3, hi]`` of the engine: term ``j`` has its peak
     (membership 1) at ``peaks[j]``; the first and last terms are shoulders.
+
+    ``dof`` is the rulebook's DOF: some ranges depend on it (goal-frame's
+    ``joint_dist_to_goal``), so a partition is validated against the range at that DOF.
     """
 
     name: str
     terms: tuple[str, ...]
     peaks: tuple[float, ...]
+    dof: int = _sem.DEFAULT_DOF
 
     def __post_init__(self) -> None:
         if self.name not in _sem.ALL_INPUT_RANGES:
             raise ValueError(f"unknown input variable {self.name!r}; inputs are "
                              f"{', '.join(_sem.ALL_INPUT_RANGES)}")
+        problem = _sem.dof_problem(self.dof)
+        if problem:
+            raise ValueError(f"{self.name}: {problem}")
         object.__setattr__(self, "terms", tuple(str(t) for t in self.terms))
         object.__setattr__(self, "peaks", tuple(float(p) for p in self.peaks))
         if len(self.terms) != N_TERMS:
@@ -82,8 +89,8 @@ class InputPartition:
 
     @property
     def range(self) -> tuple[float, float]:
-        """The variable's range (fixed by its semantics, not per rulebook)."""
-        return _sem.ALL_INPUT_RANGES[self.name]
+        """The variable's range (fixed by its semantics and DOF, not per rulebook)."""
+        return _sem.input_range(self.name, self.dof)
 
 
 @dataclass(frozen=True)
@@ -91,23 +98,34 @@ class FuzzySystem:
     """A zero-order Takagi-Sugeno system with one output and the 625-rule grid.
 
     ``consts[r]`` is the consequent of rule ``r`` (index convention in :mod:`.variables`).
+    ``dof`` (default: that of the inputs) is the rulebook's DOF; it decides which outputs exist
+    (``bound_5`` needs a paper rulebook of at least 3 joints) and the inputs' ranges.
     """
 
     output: str
     inputs: tuple[InputPartition, ...]
     consts: tuple[float, ...]
+    dof: int | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inputs", tuple(self.inputs))
         object.__setattr__(self, "consts", tuple(float(c) for c in self.consts))
+        if self.dof is None:
+            object.__setattr__(self, "dof", self.inputs[0].dof if self.inputs else _sem.DEFAULT_DOF)
+        problem = _sem.dof_problem(self.dof)
+        if problem:
+            raise ValueError(f"{self.output}: {problem}")
+        if any(i.dof != self.dof for i in self.inputs):
+            raise ValueError(f"{self.output}: inputs are for dof {[i.dof for i in self.inputs]}, "
+                             f"the system for dof {self.dof}")
         names = tuple(i.name for i in self.inputs)
-        sem = _sem.of_inputs(names[0]) if names else None
+        sem = _sem.of_inputs(names[0], self.dof) if names else None
         if sem is None or names != sem.inputs:
             raise ValueError(f"{self.output}: inputs must be those of one semantics in order "
                              f"(e.g. {_sem.PAPER.inputs}), got {names}")
         if self.output not in sem.outputs:
             raise ValueError(f"unknown output variable {self.output!r} for the {sem.name} "
-                             f"semantics; outputs are {sem.outputs}")
+                             f"semantics at dof {self.dof}; outputs are {sem.outputs}")
         if len(self.consts) != N_RULES:
             raise ValueError(f"{self.output}: expected {N_RULES} rule constants, got {len(self.consts)}")
         lo, hi = self.range
@@ -119,8 +137,8 @@ class FuzzySystem:
 
     @property
     def semantics(self) -> "_sem.Semantics":
-        """The semantics this system's inputs belong to."""
-        return _sem.of_inputs(self.inputs[0].name)
+        """The semantics (at this system's DOF) its inputs belong to."""
+        return _sem.of_inputs(self.inputs[0].name, self.dof)
 
     @property
     def range(self) -> tuple[float, float]:

@@ -266,8 +266,8 @@ def parse_fis(data: bytes, file: str, expected_output: str,
     """Parse one FIS file. Returns the system (``None`` if anything is wrong) and all problems.
 
     *file* is the name used in problem messages; *expected_output* is the output this file must
-    describe (its stem); *semantics* (from the rulebook manifest) fixes the input names, their
-    order and every range.
+    describe (its stem); *semantics* (from the rulebook manifest, at its DOF) fixes the input
+    names, their order and every range.
     """
     lines, problems = decode_lines(data, file)
     st = _State(file=file, expected_output=expected_output, sem=semantics, problems=problems)
@@ -360,7 +360,7 @@ def _input(st: _State, n: int, words: list[str]) -> None:
     if name != expected:
         hint = "unknown input variable" if name not in inputs else "input out of order"
         other = _sem.of_input(name)
-        if other is not None and other is not st.sem:
+        if other is not None and other.name != st.sem.name:
             hint = f"input of the {other.name} semantics (the manifest says {st.sem.name})"
         st.problem(n, f"{hint} {name!r} (input {k + 1} must be {expected!r})")
         decl.name = expected  # check the rest as if it were the expected one
@@ -368,7 +368,19 @@ def _input(st: _State, n: int, words: list[str]) -> None:
         return
     problem = _range_problem(words, st.sem.input_ranges[name], name)
     if problem:
-        st.problem(n, problem)
+        st.problem(n, problem + _dof_hint(st.sem, name, words))
+
+
+def _dof_hint(sem: "_sem.Semantics", name: str, words: list[str]) -> str:
+    """``' (the range at dof = 2; the manifest says dof = 5)'`` when a range depends on the
+    DOF and the file's range is that of another DOF (a FIS copied from another rulebook)."""
+    if len(words) != 5:
+        return ""
+    got = (_parse_float(words[3]), _parse_float(words[4]))
+    for d in range(_sem.MIN_DOF, _sem.MAX_DOF + 1):
+        if d != sem.dof and sem.for_dof(d).input_ranges[name] == got:
+            return f" (the range at dof = {d}; the manifest says dof = {sem.dof})"
+    return ""
 
 
 def _input_detail(st: _State, n: int, key: str, words: list[str]) -> None:
@@ -601,7 +613,7 @@ def _report_gaps(st: _State, present: list[int], missing: list[int], at_end: int
 
 def _build(st: _State) -> FuzzySystem:
     inputs = tuple(
-        InputPartition(name=d.name, terms=d.terms, peaks=d.peaks) for d in st.inputs
+        InputPartition(name=d.name, terms=d.terms, peaks=d.peaks, dof=st.sem.dof) for d in st.inputs
     )
     consts = tuple(st.rules[r][1] for r in range(N_RULES))
-    return FuzzySystem(output=st.expected_output, inputs=inputs, consts=consts)
+    return FuzzySystem(output=st.expected_output, inputs=inputs, consts=consts, dof=st.sem.dof)

@@ -34,9 +34,8 @@ from xfuzzy_rrt.geometry.collision import (
     check_clearance,
     clearance_kernel,
     effective_margin,
-    link_motion_bound,
 )
-from xfuzzy_rrt.geometry.path_check import signed_segment_obstacle_dist
+from xfuzzy_rrt.geometry.signed import element_clearances, element_motion_bounds, n_elements
 
 #: The exact minimum clearance along a path is bracketed to within this (metres).
 MIN_CLEARANCE_TOL_M = 1e-9
@@ -96,7 +95,7 @@ def check_endpoints_keep(scenario, clearance_m: float, margin: float, where: str
     """Raise one InputError when the start or the goal is within ``margin`` of an obstacle."""
     a = scenario.arrays()
     for label, q in (("start", a.start_deg), ("goal", a.goal_deg)):
-        c = float(clearance_kernel(a.links, a.base, a.link_radius, a.obstacles, q))
+        c = float(clearance_kernel(a.problem(margin), q))
         if not c > margin:
             raise InputError(where, f"the {label} configuration is {_mm(c)} from an obstacle, "
                              f"closer than the clearance {_mm(clearance_m)}: no path can keep it")
@@ -125,30 +124,6 @@ class MinClearance:
 
 
 @nb.njit(cache=True, nogil=True)
-def link_clearances(links, base, radius, obstacles, q_deg, out):
-    """Signed clearance of each link capsule (``out[k]``) to its nearest obstacle; the min."""
-    best = np.inf
-    x = base[0]
-    y = base[1]
-    theta = 0.0
-    for k in range(links.shape[0]):
-        theta += math.radians(q_deg[k])
-        nx = x + links[k] * math.cos(theta)
-        ny = y + links[k] * math.sin(theta)
-        ck = np.inf
-        for o in range(obstacles.shape[0]):
-            d = signed_segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - radius
-            if d < ck:
-                ck = d
-        out[k] = ck
-        if ck < best:
-            best = ck
-        x = nx
-        y = ny
-    return best
-
-
-@nb.njit(cache=True, nogil=True)
 def _interval_bound(c0, c1, mk, width):
     """Nothing on the interval is below this: min over links of ``(c0_k + c1_k - M_k w) / 2``."""
     lb = np.inf
@@ -160,7 +135,7 @@ def _interval_bound(c0, c1, mk, width):
 
 
 @nb.njit(cache=True, nogil=True)
-def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals, decide_contact):
+def min_clearance_kernel(P, path, tol, max_evals, decide_contact):
     """``(value, segment, s, lower bound)`` of the signed clearance along ``path`` (degrees).
 
     With ``decide_contact`` an interval is also refined while it might hold a contact the
@@ -169,21 +144,23 @@ def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals, d
     minimum the work grows like ``1 / sqrt(tol)``, and only the trials that come within
     ``tol`` of touching pay for the sign.
 
-    Branch and bound per segment with one Lipschitz constant per link (``M_k``: inner links
-    move less, so a link that is far from everything stops costing evaluations early);
+    Branch and bound per segment with one Lipschitz constant per element (a link against the
+    obstacles, ``M_k``, or a pair of links of different arms, ``M_k + M_m``; see
+    ``geometry/signed.py``): inner links move less, so a link that is far from everything
+    stops costing evaluations early;
     segments are visited in the order of their initial bound, so the best value is tight
     early and prunes the rest.
     """
     n = path.shape[0]
-    nl = links.shape[0]
-    if obstacles.shape[0] == 0 or n == 0:
+    nl = n_elements(P)
+    if (P.obstacles.shape[0] == 0 and P.arm_first.shape[0] == 2) or n == 0:
         return np.inf, -1, 0.0, np.inf
     cv = np.empty((n, nl))
     best = np.inf
     best_seg = 0
     best_s = 0.0
     for i in range(n):
-        c = link_clearances(links, base, radius, obstacles, path[i], cv[i])
+        c = element_clearances(P, path[i], cv[i])
         if c < best:
             best = c
             if i < n - 1 or n == 1:
@@ -197,8 +174,7 @@ def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals, d
     mks = np.empty((n - 1, nl))
     first = np.empty(n - 1)
     for i in range(n - 1):
-        for k in range(nl):
-            mks[i, k] = link_motion_bound(links, path[i], path[i + 1], k)
+        element_motion_bounds(P, path[i], path[i + 1], mks[i])
         first[i] = _interval_bound(cv[i], cv[i + 1], mks[i], 1.0)
     order = np.argsort(first)
     floor = np.inf
@@ -237,7 +213,7 @@ def min_clearance_kernel(links, base, radius, obstacles, path, tol, max_evals, d
                 continue
             for d in range(q.shape[0]):
                 q[d] = qa[d] + sm * (qb[d] - qa[d])
-            c = link_clearances(links, base, radius, obstacles, q, cm)
+            c = element_clearances(P, q, cm)
             evals += 1
             if c < best:
                 best = c
@@ -287,9 +263,8 @@ def path_min_clearance(arrays, path_deg, tol: float = MIN_CLEARANCE_TOL_M,
         raise InputError("path", "contains non-finite angles")
     if not (tol > 0.0 and math.isfinite(tol)):
         raise InputError("tol", f"must be a positive number of metres, got {tol!r}")
-    value, seg, s, lower = min_clearance_kernel(arrays.links, arrays.base, arrays.link_radius,
-                                                arrays.obstacles, path, float(tol),
-                                                int(max_evals), False)
+    value, seg, s, lower = min_clearance_kernel(arrays.problem(CERT_MARGIN_M), path,
+                                                float(tol), int(max_evals), False)
     seg = int(seg)
     where: tuple[float, ...] = ()
     if seg >= 0:

@@ -43,6 +43,7 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.geometry.kinematics import fk_step
 
 #: Minimum clearance (metres) a configuration must keep to count as free for the planners.
 CERT_MARGIN_M = 1e-6
@@ -147,23 +148,87 @@ def _link_clearance(ax, ay, bx, by, radius, obstacles):
     return best
 
 
-@nb.njit(cache=True, nogil=True)
-def clearance_kernel(links, base, radius, obstacles, q_deg):
-    """Smallest distance between any link capsule and any obstacle (<= 0: collision).
+@nb.njit(cache=True, nogil=True, inline="always")
+def _orient(ax, ay, bx, by, cx, cy):
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
 
-    ``inf`` when there are no obstacles. Joint limits are not considered here.
+
+@nb.njit(cache=True, nogil=True)
+def segment_segment_dist(ax, ay, bx, by, cx, cy, dx, dy):
+    """Exact distance between the closed segments AB and CD in the plane (0 when they meet).
+
+    Disjoint segments: the closest pair involves an endpoint of one of them, so the distance is
+    the smallest of four point-segment distances. Meeting is decided with exact orientation
+    signs (collinear overlaps included), so touching segments give 0, not a rounding residue.
+    """
+    o1 = _orient(ax, ay, bx, by, cx, cy)
+    o2 = _orient(ax, ay, bx, by, dx, dy)
+    o3 = _orient(cx, cy, dx, dy, ax, ay)
+    o4 = _orient(cx, cy, dx, dy, bx, by)
+    if ((o1 > 0.0 and o2 < 0.0) or (o1 < 0.0 and o2 > 0.0)) and \
+            ((o3 > 0.0 and o4 < 0.0) or (o3 < 0.0 and o4 > 0.0)):
+        return 0.0
+    d = _point_segment_dist(cx, cy, ax, ay, bx, by)
+    d = min(d, _point_segment_dist(dx, dy, ax, ay, bx, by))
+    d = min(d, _point_segment_dist(ax, ay, cx, cy, dx, dy))
+    d = min(d, _point_segment_dist(bx, by, cx, cy, dx, dy))
+    return d
+
+
+@nb.njit(cache=True, nogil=True)
+def link_segments_into(P, q_deg, seg):
+    """Every link of every arm as a segment ``seg[k] = (ax, ay, bx, by)`` (metres)."""
+    for a in range(P.arm_first.shape[0] - 1):
+        x = P.bases[a, 0]
+        y = P.bases[a, 1]
+        theta = 0.0
+        for k in range(P.arm_first[a], P.arm_first[a + 1]):
+            nx, ny, theta = fk_step(x, y, theta, P.links[k], q_deg[k])
+            seg[k, 0] = x
+            seg[k, 1] = y
+            seg[k, 2] = nx
+            seg[k, 3] = ny
+            x = nx
+            y = ny
+
+
+@nb.njit(cache=True, nogil=True)
+def arm_arm_clearance(P, seg):
+    """Smallest capsule-capsule distance between links of different arms (``inf``: one arm)."""
+    best = np.inf
+    n_arms = P.arm_first.shape[0] - 1
+    for a in range(n_arms):
+        for b in range(a + 1, n_arms):
+            rr = P.radii[a] + P.radii[b]
+            for k in range(P.arm_first[a], P.arm_first[a + 1]):
+                for m in range(P.arm_first[b], P.arm_first[b + 1]):
+                    d = segment_segment_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
+                                             seg[m, 0], seg[m, 1], seg[m, 2], seg[m, 3]) - rr
+                    if d < best:
+                        best = d
+    return best
+
+
+@nb.njit(cache=True, nogil=True)
+def clearance_kernel(P, q_deg):
+    """Smallest distance between any link capsule and any obstacle or any other arm's capsule
+    (<= 0: collision); ``inf`` for one arm without obstacles. Joint limits are not considered.
     """
     best = np.inf
-    x = base[0]
-    y = base[1]
-    theta = 0.0
-    for k in range(links.shape[0]):
-        theta += math.radians(q_deg[k])
-        nx = x + links[k] * math.cos(theta)
-        ny = y + links[k] * math.sin(theta)
-        best = min(best, _link_clearance(x, y, nx, ny, radius, obstacles))
-        x = nx
-        y = ny
+    n_arms = P.arm_first.shape[0] - 1
+    for a in range(n_arms):
+        x = P.bases[a, 0]
+        y = P.bases[a, 1]
+        theta = 0.0
+        for k in range(P.arm_first[a], P.arm_first[a + 1]):
+            nx, ny, theta = fk_step(x, y, theta, P.links[k], q_deg[k])
+            best = min(best, _link_clearance(x, y, nx, ny, P.radii[a], P.obstacles))
+            x = nx
+            y = ny
+    if n_arms > 1:
+        seg = np.empty((P.links.shape[0], 4))
+        link_segments_into(P, q_deg, seg)
+        best = min(best, arm_arm_clearance(P, seg))
     return best
 
 
@@ -176,24 +241,26 @@ def within_limits(limits_deg, q_deg):
 
 
 @nb.njit(cache=True, nogil=True)
-def config_free(links, base, radius, obstacles, limits_deg, q_deg, margin):
+def config_free(P, q_deg, margin):
     """Within the joint limits and clearance strictly above ``margin``."""
-    if not within_limits(limits_deg, q_deg):
+    if not within_limits(P.limits, q_deg):
         return False
-    return clearance_kernel(links, base, radius, obstacles, q_deg) > margin
+    return clearance_kernel(P, q_deg) > margin
 
 
 @nb.njit(cache=True, nogil=True)
-def link_motion_bound(links, qa_deg, qb_deg, k):
+def link_motion_bound(links, qa_deg, qb_deg, k, first=0):
     """``M_k``: no point of link ``k`` moves faster than this per unit ``s`` on ``qa -> qb``.
 
-    ``M_k = Σ_{j <= k} |Δq_j| · Σ_{i=j..k} l_i`` (Δq in radians; see the module docstring).
-    A function of its own so that the bound the certified check relies on can be tested
-    directly (tests/test_safety_bounds.py): if it ever under-estimates the true motion, even
-    by a few per cent, ``edge_free`` could step over an obstacle.
+    ``M_k = Σ_{first <= j <= k} |Δq_j| · Σ_{i=j..k} l_i`` (Δq in radians; see the module
+    docstring), where ``first`` is the index of the first joint of link ``k``'s arm (0 for one
+    arm): joints of other arms do not move this link. A function of its own so that the bound
+    the certified check relies on can be tested directly (tests/test_safety_bounds.py,
+    tests/test_motion_bound_ndof.py): if it ever under-estimates the true motion, even by a few
+    per cent, ``edge_free`` could step over an obstacle.
     """
     mk = 0.0
-    for j in range(k + 1):
+    for j in range(first, k + 1):
         tail = 0.0
         for i in range(j, k + 1):
             tail += links[i]
@@ -202,50 +269,83 @@ def link_motion_bound(links, qa_deg, qb_deg, k):
 
 
 @nb.njit(cache=True, nogil=True)
-def edge_free(links, base, radius, obstacles, qa_deg, qb_deg, margin):
+def edge_free(P, qa_deg, qb_deg, margin):
     """Certified check of the straight joint segment ``qa -> qb`` (conservative advancement).
 
     Returns True only if every configuration on the segment keeps clearance >=
     ``margin - CERT_MARGIN_M`` (the user clearance; > 0 when that is 0) and the sampled stops
-    keep clearance > ``margin``. Both endpoints must be within the joint limits already (the
-    box is convex, so the whole segment then is). See the module docstring.
+    keep clearance > ``margin``, against obstacles and between arms. Both endpoints must be
+    within the joint limits already (the box is convex, so the whole segment then is). See the
+    module docstring; for two links of different arms the Lipschitz constant of their distance
+    is the sum of the two links' motion bounds, each from its own arm's joints.
     """
-    n = links.shape[0]
-    if obstacles.shape[0] == 0:
+    n_arms = P.arm_first.shape[0] - 1
+    obstacles = P.obstacles
+    has_obstacles = obstacles.shape[0] > 0
+    if not has_obstacles and n_arms == 1:
         return True
     # The user clearance folded into ``margin`` (exactly 0.0 for the default margin).
     clear = margin - CERT_MARGIN_M
     if not clear > 0.0:
         clear = 0.0
+    seg = np.empty((P.links.shape[0] if n_arms > 1 else 0, 4))
     s = 0.0
     while True:
         # Per-link clearance at q(s) and the safe advance it buys.
-        x = base[0]
-        y = base[1]
-        theta = 0.0
         cmin = np.inf
         ds = np.inf
-        for k in range(n):
-            qk = qa_deg[k] + s * (qb_deg[k] - qa_deg[k])
-            if s >= 1.0:
-                qk = qb_deg[k]
-            theta += math.radians(qk)
-            nx = x + links[k] * math.cos(theta)
-            ny = y + links[k] * math.sin(theta)
-            ck = _link_clearance(x, y, nx, ny, radius, obstacles)
-            if not ck < np.inf:
-                # With obstacles present a finite geometry has a finite clearance: inf or NaN
-                # means the arithmetic overflowed, and an infinite step would skip the segment.
-                return False
-            x = nx
-            y = ny
-            if ck < cmin:
-                cmin = ck
-            mk = link_motion_bound(links, qa_deg, qb_deg, k)
-            if mk > 0.0:
-                step = (ck - clear) / mk
-                if step < ds:
-                    ds = step
+        for a in range(n_arms):
+            x = P.bases[a, 0]
+            y = P.bases[a, 1]
+            theta = 0.0
+            first = P.arm_first[a]
+            for k in range(first, P.arm_first[a + 1]):
+                qk = qa_deg[k] + s * (qb_deg[k] - qa_deg[k])
+                if s >= 1.0:
+                    qk = qb_deg[k]
+                nx, ny, theta = fk_step(x, y, theta, P.links[k], qk)
+                if n_arms > 1:
+                    seg[k, 0] = x
+                    seg[k, 1] = y
+                    seg[k, 2] = nx
+                    seg[k, 3] = ny
+                if has_obstacles:
+                    ck = _link_clearance(x, y, nx, ny, P.radii[a], obstacles)
+                    if not ck < np.inf:
+                        # With obstacles present a finite geometry has a finite clearance: inf
+                        # or NaN means the arithmetic overflowed, and an infinite step would
+                        # skip the segment.
+                        return False
+                    if ck < cmin:
+                        cmin = ck
+                    mk = link_motion_bound(P.links, qa_deg, qb_deg, k, first)
+                    if mk > 0.0:
+                        step = (ck - clear) / mk
+                        if step < ds:
+                            ds = step
+                x = nx
+                y = ny
+        if n_arms > 1:
+            for a in range(n_arms):
+                fa = P.arm_first[a]
+                for b in range(a + 1, n_arms):
+                    fb = P.arm_first[b]
+                    rr = P.radii[a] + P.radii[b]
+                    for k in range(fa, P.arm_first[a + 1]):
+                        mka = link_motion_bound(P.links, qa_deg, qb_deg, k, fa)
+                        for m in range(fb, P.arm_first[b + 1]):
+                            d = segment_segment_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
+                                                     seg[m, 0], seg[m, 1], seg[m, 2],
+                                                     seg[m, 3]) - rr
+                            if not d < np.inf:
+                                return False
+                            if d < cmin:
+                                cmin = d
+                            mkm = mka + link_motion_bound(P.links, qa_deg, qb_deg, m, fb)
+                            if mkm > 0.0:
+                                step = (d - clear) / mkm
+                                if step < ds:
+                                    ds = step
         if cmin <= margin:
             return False
         if s >= 1.0:
@@ -295,6 +395,52 @@ def nearest_obstacle_from_point(px, py, obstacles):
 
 
 @nb.njit(cache=True, nogil=True)
+def nearest_obstacle_for_arm(P, arm, q_deg, px, py):
+    """:func:`nearest_obstacle_from_point` for a point of arm ``arm``, where the other arms'
+    link capsules count as obstacles too (a second arm is an obstacle to the first).
+
+    Returns ``(distance, angle, index)``; ``index`` is ``-1 - k`` when the nearest thing is
+    link ``k`` of another arm. With one arm it is exactly :func:`nearest_obstacle_from_point`.
+    """
+    best, angle, index = nearest_obstacle_from_point(px, py, P.obstacles)
+    n_arms = P.arm_first.shape[0] - 1
+    if n_arms == 1:
+        return best, angle, index
+    for b in range(n_arms):
+        if b == arm:
+            continue
+        x = P.bases[b, 0]
+        y = P.bases[b, 1]
+        theta = 0.0
+        for k in range(P.arm_first[b], P.arm_first[b + 1]):
+            nx, ny, theta = fk_step(x, y, theta, P.links[k], q_deg[k])
+            dx = nx - x
+            dy = ny - y
+            den = dx * dx + dy * dy
+            t = 0.0
+            if den > 0.0:
+                t = ((px - x) * dx + (py - y) * dy) / den
+                t = min(max(t, 0.0), 1.0)
+            vx = x + t * dx - px
+            vy = y + t * dy - py
+            d = math.sqrt(vx * vx + vy * vy) - P.radii[b]
+            if d < 0.0:
+                d = 0.0
+            if d < best:
+                best = d
+                index = -1 - k
+                a = math.atan2(vy, vx)
+                if a < 0.0:
+                    a += _TWO_PI
+                if a >= _TWO_PI:
+                    a -= _TWO_PI
+                angle = a
+            x = nx
+            y = ny
+    return best, angle, index
+
+
+@nb.njit(cache=True, nogil=True)
 def direction_and_distance(px, py, tx, ty):
     """Distance from P to T and the direction of T seen from P, wrapped to [0, 2π)."""
     vx = tx - px
@@ -312,13 +458,14 @@ def direction_and_distance(px, py, tx, ty):
 # ----------------------------------------------------------------------------------------------
 
 def clearance(arrays, q_deg) -> float:
-    """Clearance of configuration ``q_deg`` in a :class:`ScenarioArrays` (<= 0: collision)."""
-    return float(clearance_kernel(arrays.links, arrays.base, arrays.link_radius,
-                                  arrays.obstacles, np.asarray(q_deg, dtype=np.float64)))
+    """Clearance of configuration ``q_deg`` in a :class:`ScenarioArrays` (<= 0: collision),
+    against obstacles and between arms."""
+    return float(clearance_kernel(arrays.problem(CERT_MARGIN_M),
+                                  np.asarray(q_deg, dtype=np.float64)))
 
 
 def in_collision(arrays, q_deg) -> bool:
-    """True when ``q_deg`` violates a joint limit or a link touches an obstacle."""
+    """True when ``q_deg`` violates a joint limit or a link touches an obstacle or another arm."""
     q = np.asarray(q_deg, dtype=np.float64)
     if not within_limits(arrays.limits_deg, q):
         return True
@@ -355,8 +502,7 @@ def segment_free(arrays, qa_deg, qb_deg, margin: float = CERT_MARGIN_M) -> bool:
     qb = np.asarray(qb_deg, dtype=np.float64)
     if not (within_limits(arrays.limits_deg, qa) and within_limits(arrays.limits_deg, qb)):
         return False
-    return bool(edge_free(arrays.links, arrays.base, arrays.link_radius, arrays.obstacles,
-                          qa, qb, margin))
+    return bool(edge_free(arrays.problem(margin), qa, qb, float(margin)))
 
 
 def end_effector_obstacle(arrays, q_deg) -> tuple[float, float]:

@@ -46,12 +46,12 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.geometry.collision import (
-    CERT_MARGIN_M,
-    edge_free,
-    link_motion_bound,
-    segment_obstacle_dist,
-    within_limits,
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, edge_free, within_limits
+# Signed distances live in geometry/signed.py; re-exported here, where callers used to find them.
+from xfuzzy_rrt.geometry.signed import (  # noqa: F401
+    signed_clearance,
+    signed_clearance_kernel,
+    signed_segment_obstacle_dist,
 )
 
 #: The exact minimum clearance along a path is bracketed to within this (metres): 0.1 um, a
@@ -104,100 +104,21 @@ class PathCheck:
 
 
 @nb.njit(cache=True, nogil=True)
-def signed_segment_obstacle_dist(ax, ay, bx, by, ob):
-    """Exact signed distance from segment AB to obstacle row ``ob``; negative = depth inside."""
-    if ob[0] == 0.0:  # circle: distance from the centre to the segment, minus the radius
-        dx = bx - ax
-        dy = by - ay
-        den = dx * dx + dy * dy
-        t = 0.0
-        if den > 0.0:
-            t = ((ob[1] - ax) * dx + (ob[2] - ay) * dy) / den
-            if t < 0.0:
-                t = 0.0
-            elif t > 1.0:
-                t = 1.0
-        qx = ax + t * dx - ob[1]
-        qy = ay + t * dy - ob[2]
-        return math.sqrt(qx * qx + qy * qy) - ob[3]
-    d = segment_obstacle_dist(ax, ay, bx, by, ob)
-    if d > 0.0:
-        return d
-    # Intersecting: minimum translation distance by the separating axis theorem. Candidate
-    # axes are the rectangle's normals (x, y) and the segment's normal.
-    x0 = ob[1]
-    y0 = ob[2]
-    x1 = ob[3]
-    y1 = ob[4]
-    depth = min(max(ax, bx) - x0, x1 - min(ax, bx))
-    depth = min(depth, min(max(ay, by) - y0, y1 - min(ay, by)))
-    dx = bx - ax
-    dy = by - ay
-    norm = math.sqrt(dx * dx + dy * dy)
-    if norm > 0.0:
-        nx = -dy / norm
-        ny = dx / norm
-        seg = ax * nx + ay * ny  # the whole segment projects to this one value
-        lo = np.inf
-        hi = -np.inf
-        for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
-            p = cx * nx + cy * ny
-            lo = min(lo, p)
-            hi = max(hi, p)
-        depth = min(depth, min(seg - lo, hi - seg))
-    return -max(depth, 0.0)
-
-
-@nb.njit(cache=True, nogil=True)
-def signed_clearance_kernel(links, base, radius, obstacles, q_deg):
-    """Smallest signed link-capsule clearance (negative: penetration depth), ``inf`` if empty."""
-    best = np.inf
-    x = base[0]
-    y = base[1]
-    theta = 0.0
-    for k in range(links.shape[0]):
-        theta += math.radians(q_deg[k])
-        nx = x + links[k] * math.cos(theta)
-        ny = y + links[k] * math.sin(theta)
-        for o in range(obstacles.shape[0]):
-            d = signed_segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - radius
-            if d < best:
-                best = d
-        x = nx
-        y = ny
-    return best
-
-
-@nb.njit(cache=True, nogil=True)
-def motion_bound(links, qa_deg, qb_deg):
-    """``max_k M_k``: no point of the arm moves more than this per unit of the segment.
-
-    The same bound as ``edge_free`` uses: ``M_k = Σ_{j<=k} |Δq_j| Σ_{i=j..k} l_i`` (radians).
-    """
-    best = 0.0
-    for k in range(links.shape[0]):
-        mk = link_motion_bound(links, qa_deg, qb_deg, k)
-        if mk > best:
-            best = mk
-    return best
-
-
-@nb.njit(cache=True, nogil=True)
-def certify_kernel(links, base, radius, obstacles, limits, path, margin):
+def certify_kernel(P, path, margin):
     """``(certified, first uncertified segment, first vertex outside the limits)``."""
     n = path.shape[0]
     certified = True
     first_bad = -1
     first_out = -1
     for i in range(n):
-        if first_out < 0 and not within_limits(limits, path[i]):
+        if first_out < 0 and not within_limits(P.limits, path[i]):
             first_out = i
     for i in range(n - 1):
         qa = path[i]
         qb = path[i + 1]
-        ok = within_limits(limits, qa) and within_limits(limits, qb)
+        ok = within_limits(P.limits, qa) and within_limits(P.limits, qb)
         if ok:
-            ok = edge_free(links, base, radius, obstacles, qa, qb, margin)
+            ok = edge_free(P, qa, qb, margin)
         if not ok:
             certified = False
             first_bad = i
@@ -213,7 +134,7 @@ def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
     certified when it is within the limits and keeps clearance above ``margin``.
     """
     path = np.ascontiguousarray(np.asarray(path_deg, dtype=np.float64))
-    dof = arrays.links.shape[0]
+    dof = arrays.links.shape[0]  # every arm's angles
     if path.size == 0:
         return PathCheck(certified=False, penetration_m=0.0, worst_segment=-1)
     if path.ndim != 2 or path.shape[1] != dof:
@@ -224,9 +145,9 @@ def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
     # Carlo uses it too), here at the certification's tolerance and without the contact refinement
     from xfuzzy_rrt.geometry.clearance import min_clearance_kernel
 
-    value, seg, s, lower = min_clearance_kernel(
-        arrays.links, arrays.base, float(arrays.link_radius), arrays.obstacles, path,
-        MIN_CLEARANCE_TOL_M, MIN_CLEARANCE_MAX_EVALS, False)
+    problem = arrays.problem(margin)
+    value, seg, s, lower = min_clearance_kernel(problem, path, MIN_CLEARANCE_TOL_M,
+                                                MIN_CLEARANCE_MAX_EVALS, False)
     value = float(value)
     if float(lower) < value - MIN_CLEARANCE_TOL_M:
         value = float(lower)  # budget reached: report the proven bound, never an optimistic one
@@ -244,16 +165,8 @@ def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
                          worst_segment=0 if not ok and inside else -1,
                          min_clearance_m=value, min_segment=seg, min_config_deg=where,
                          limits_vertex=-1 if inside else 0)
-    certified, first_bad, first_out = certify_kernel(
-        arrays.links, arrays.base, arrays.link_radius, arrays.obstacles, arrays.limits_deg,
-        path, float(margin))
+    certified, first_bad, first_out = certify_kernel(problem, path, float(margin))
     worst = int(seg) if penetration > 0.0 else (-1 if certified else int(first_bad))
     return PathCheck(certified=bool(certified), penetration_m=float(penetration),
                      worst_segment=worst, min_clearance_m=value, min_segment=int(seg),
                      min_config_deg=where, limits_vertex=int(first_out))
-
-
-def signed_clearance(arrays, q_deg) -> float:
-    """Signed clearance of one configuration (negative: exact penetration depth)."""
-    return float(signed_clearance_kernel(arrays.links, arrays.base, arrays.link_radius,
-                                         arrays.obstacles, np.asarray(q_deg, dtype=np.float64)))

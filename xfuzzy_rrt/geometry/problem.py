@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import numba as nb
 import numpy as np
 
 
@@ -51,3 +52,10 @@ def single_arm_problem(links, base, radius, obstacles, limits, start=None, goal=
                    np.ascontiguousarray(base, dtype=np.float64).reshape(1, 2),
                    np.array([float(radius)]), np.ascontiguousarray(obstacles, dtype=np.float64).reshape(-1, 5),
                    limits, start, goal, float(margin))
+
+
+@nb.njit(cache=True, nogil=True)
+def with_obstacles(P, obstacles):
+    """``P`` with other obstacles (the robustness analysis moves and grows them per trial)."""
+    return Problem(P.links, P.arm_first, P.bases, P.radii, obstacles, P.limits, P.start, P.goal,
+                   P.margin)

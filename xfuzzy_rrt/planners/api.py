@@ -97,7 +97,8 @@ def check_planner(name: str, where: str = "--planners") -> str:
 
 def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None, seed: int = 0,
                   max_iter: int = 10_000, step_deg: float = 10.0, goal_bias: float = 0.05,
-                  trace: bool = False, clearance_m: float | None = None) -> PlanResult:
+                  trace: bool = False, clearance_m: float | None = None,
+                  max_time_s: float | None = None) -> PlanResult:
     """Plan ``scenario`` with the named planner (a label :func:`parse_planner` accepts).
 
     ``rulebook`` (fuzzy-rrt only) is a loaded rulebook, a directory path, or ``None`` for the
@@ -107,6 +108,8 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     with our collision checker (:func:`xfuzzy_rrt.planners.ompl_bridge.plan_ompl`; needs the
     optional 'ompl' extra). The result's ``planner`` is the label. ``clearance_m``: the
     certified clearance in metres (default: the scenario's ``clearance_m``, else 0).
+    ``max_time_s``: a wall-clock budget on top of ``max_iter`` (whichever ends first;
+    :mod:`xfuzzy_rrt.planners.termination`).
     """
     spec = parse_planner(planner, "--planner")
     if spec.kind != "fuzzy-rrt" and trace:
@@ -115,7 +118,7 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
         from xfuzzy_rrt.planners.rrt import plan_rrt
 
         return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
-                        goal_bias=goal_bias, clearance_m=clearance_m)
+                        goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
     if spec.kind == "fuzzy-rrt":
         from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
 
@@ -125,12 +128,12 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
                                  "names its own rulebook); give only one")
             rulebook = rulebook if rulebook is not None else spec.rulebook_dir
         result = plan_fuzzy_rrt(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
-                                trace=trace, clearance_m=clearance_m)
+                                trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
         return dataclasses.replace(result, planner=spec.label)
     from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 
     return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, step_deg=step_deg,
-                     goal_bias=goal_bias, clearance_m=clearance_m)
+                     goal_bias=goal_bias, clearance_m=clearance_m, time_limit_s=max_time_s)
 
 
 def _same_rulebook(rulebook, directory: Path) -> bool:

@@ -6,26 +6,26 @@ import math
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import Scenario
+from xfuzzy_rrt.planners.termination import MAX_ITER_LIMIT, check_max_iter  # noqa: F401
 
-#: Largest iteration budget accepted. Tree storage is preallocated per plan (and a trace needs
-#: about 1.3 kB per iteration), so an absurd budget must fail cleanly, not exhaust memory.
-MAX_ITER_LIMIT = 1_000_000
+#: Joint-space dimensions the planners handle (all arms together).
+MIN_DOF = 2
+MAX_DOF = 28
 
 
-def check_planar_2dof(scenario: Scenario) -> None:
-    if scenario.arm.dof != 2:
-        raise InputError(scenario.source or scenario.name,
-                         f"arm.links: the planners handle 2-DOF arms, this arm has {scenario.arm.dof}")
+def check_dof(scenario: Scenario) -> None:
+    """Every arm has 2..7 joints and the problem's configurations have one angle per joint."""
+    where = scenario.source or scenario.name
+    for a, arm in enumerate(scenario.arms):
+        if not 2 <= arm.dof <= 7:
+            key = "arm.links" if len(scenario.arms) == 1 else f"arms[{a}].links"
+            raise InputError(where, f"{key}: the planners handle arms of 2 to 7 joints, this "
+                             f"arm has {arm.dof}")
+    for which, q in (("start", scenario.start_deg), ("goal", scenario.goal_deg)):
+        if len(q) != scenario.dof:
+            raise InputError(where, f"{which}: {len(q)} angles for {scenario.dof} joints")
 
 
 def check_positive(name: str, value: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
         raise InputError(name, f"must be a positive number, got {value!r}")
-
-
-def check_max_iter(max_iter: int) -> int:
-    if isinstance(max_iter, bool) or not isinstance(max_iter, int):
-        raise InputError("max_iter", f"must be an integer, got {max_iter!r}")
-    if not 1 <= max_iter <= MAX_ITER_LIMIT:
-        raise InputError("max_iter", f"must lie in [1, {MAX_ITER_LIMIT}], got {max_iter}")
-    return max_iter

@@ -25,39 +25,45 @@ from xfuzzy_rrt.planners.tree import add_node
 
 
 @nb.njit(cache=True, nogil=True)
-def extend(links, base, radius, obstacles, limits, goal, margin,
-           nodes, parent, cell_next, cell_head, meta, grid, near, sx, sy, step, q_near, q_new):
-    """Extend the tree from node ``near`` towards ``(sx, sy)``.
+def extend(P, T, near, sample, step, q_near, q_new):
+    """Extend tree ``T`` from node ``near`` towards ``sample`` in problem ``P``.
 
     Writes the near and new configurations into ``q_near``/``q_new`` and returns
     ``(outcome, index)``: the index of the last node added (the goal on success) or -1.
+    Distances are Euclidean in joint space (degrees), over every joint of every arm.
     """
-    q_near[0] = nodes[near, 0]
-    q_near[1] = nodes[near, 1]
-    dx = sx - q_near[0]
-    dy = sy - q_near[1]
-    d = math.sqrt(dx * dx + dy * dy)
+    dof = q_near.shape[0]
+    d2 = 0.0
+    for j in range(dof):
+        q_near[j] = T.nodes[near, j]
+        dj = sample[j] - q_near[j]
+        d2 += dj * dj
+    d = math.sqrt(d2)
     if d == 0.0:
-        q_new[0] = q_near[0]
-        q_new[1] = q_near[1]
+        for j in range(dof):
+            q_new[j] = q_near[j]
         return NO_PROGRESS, -1
     if d <= step:
-        q_new[0] = sx
-        q_new[1] = sy
+        for j in range(dof):
+            q_new[j] = sample[j]
     else:
-        q_new[0] = q_near[0] + dx * (step / d)
-        q_new[1] = q_near[1] + dy * (step / d)
-    if not config_free(links, base, radius, obstacles, limits, q_new, margin):
+        for j in range(dof):
+            q_new[j] = q_near[j] + (sample[j] - q_near[j]) * (step / d)
+    if not config_free(P, q_new, P.margin):
         return NODE_IN_COLLISION, -1
-    if not edge_free(links, base, radius, obstacles, q_near, q_new, margin):
+    if not edge_free(P, q_near, q_new, P.margin):
         return EDGE_BLOCKED, -1
-    k = add_node(nodes, parent, cell_next, cell_head, meta, grid, q_new[0], q_new[1], near)
-    if q_new[0] == goal[0] and q_new[1] == goal[1]:
+    k = add_node(T, q_new, near)
+    at_goal = True
+    g2 = 0.0
+    for j in range(dof):
+        if q_new[j] != P.goal[j]:
+            at_goal = False
+        gj = P.goal[j] - q_new[j]
+        g2 += gj * gj
+    if at_goal:
         return GOAL_REACHED, k
-    gx = goal[0] - q_new[0]
-    gy = goal[1] - q_new[1]
-    if math.sqrt(gx * gx + gy * gy) <= step and edge_free(
-            links, base, radius, obstacles, q_new, goal, margin):
-        g = add_node(nodes, parent, cell_next, cell_head, meta, grid, goal[0], goal[1], k)
+    if math.sqrt(g2) <= step and edge_free(P, q_new, P.goal, P.margin):
+        g = add_node(T, P.goal, k)
         return GOAL_REACHED, g
     return ACCEPTED, k

@@ -15,6 +15,16 @@ Each iteration, read top to bottom in :func:`fuzzy_rrt_kernel`:
 6. Reject the new node if it is in collision, or if the edge to it is not certified free.
 7. Add it; succeed if it *is* the goal, or if the goal is within ``step`` and that edge is free.
 
+**Several joints and several arms.** With ``N`` joints per arm a paper-semantics rulebook has
+``2N`` bound outputs (joint ``j``'s interval is ``[bound_{2j-1}, bound_{2j}]``) plus goal bias
+and step. With several arms, each arm's end effector is read by the same rulebook (the arms
+are identical in kind; the rulebook's DOF is one arm's): its inputs are that arm's angle and
+distance to its own goal position and to its nearest obstacle, *the other arms' link capsules
+included*, and its bound outputs give that arm's joint intervals. The sample is one
+configuration of all arms: the goal with probability the *mean* of the arms' goal biases, else
+drawn from the product of the arms' boxes; the step is the *smallest* of the arms' steps (the
+most cautious arm sets the pace). With one arm both reduce to the paper's loop exactly.
+
 The ``nearest_node`` carried into the next iteration is the one found for the last sample,
 accepted or not, exactly as in the paper's pseudocode (it is not reset to the new node).
 
@@ -44,20 +54,22 @@ import time
 import numba as nb
 import numpy as np
 
+from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.engine import infer
-from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_OUTPUTS
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.clearance import planning_margin
-from xfuzzy_rrt.geometry.collision import (
-    direction_and_distance,
-    nearest_obstacle_from_point,
-)
-from xfuzzy_rrt.geometry.kinematics import end_effector
+from xfuzzy_rrt.geometry.collision import direction_and_distance, nearest_obstacle_for_arm
+from xfuzzy_rrt.geometry.kinematics import arm_end_effector
 from xfuzzy_rrt.geometry.scenario import Scenario
+from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
 from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
+from xfuzzy_rrt.planners.params import resolve_params
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
-from xfuzzy_rrt.planners.checks import check_max_iter, check_planar_2dof
-from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path, nearest
+from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
+from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
+from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
 MIN_STEP_DEG = 0.5
@@ -76,11 +88,33 @@ def kernel_mode(rb) -> int:
 
 def kernel_for(mode: int):
     """The compiled loop for *mode*: the paper's Algorithm 1 or its goal-frame variant."""
-    if mode == GOAL_FRAME:
-        from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
+    return goal_frame_kernel if mode == GOAL_FRAME else fuzzy_rrt_kernel
 
-        return goal_frame_kernel
-    return fuzzy_rrt_kernel
+
+def fis_groups(rb, scenario: Scenario) -> int:
+    """Fuzzy evaluations per iteration: one per arm (paper), one for all arms (goal-frame)."""
+    return 1 if kernel_mode(rb) == GOAL_FRAME else len(scenario.arms)
+
+
+def check_rulebook_fits(rb, scenario: Scenario) -> None:
+    """One clear error when the rulebook's DOF does not match the arm(s) it is asked to drive.
+
+    Paper semantics reads one arm at a time, so its DOF is each arm's; goal-frame reads the
+    joint space of all arms together, so its DOF is the total.
+    """
+    dof = int(getattr(rb, "dof", 2))
+    where = scenario.source or scenario.name
+    if kernel_mode(rb) == GOAL_FRAME:
+        if dof != scenario.dof:
+            raise InputError(where, f"rulebook {rb.name!r} is a {dof}-DOF goal-frame rulebook; "
+                             f"this problem has {scenario.dof} joints in all (train or pick a "
+                             f"{scenario.dof}-DOF rulebook)")
+        return
+    for a, arm in enumerate(scenario.arms):
+        if arm.dof != dof:
+            which = "the arm" if len(scenario.arms) == 1 else f"arm {a + 1}"
+            raise InputError(where, f"rulebook {rb.name!r} is a {dof}-DOF rulebook; {which} "
+                             f"has {arm.dof} joints (train or pick a {arm.dof}-DOF rulebook)")
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -102,132 +136,100 @@ def _interval(lo_raw, hi_raw, offset, limit_lo, limit_hi):
     return lo, hi
 
 
-@nb.njit(cache=True, nogil=True, inline="always")
-def record_iteration(row, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample, tr_nearest,
-                     tr_new, tr_outcome, tr_node, tr_tree, from_node, x, y, box_lo0, box_hi0,
-                     box_lo1, box_hi1, goal_sampled, sx, sy, nearest_node, q_new, outcome,
-                     new_index, tree_size):
-    """Write trace row *row* (shared by every Fuzzy-RRT kernel, so traces mean one thing)."""
-    tr_from[row] = from_node
-    for k in range(x.shape[0]):
-        tr_x[row, k] = x[k]
-    for k in range(y.shape[0]):
-        tr_y[row, k] = y[k]
-    tr_box[row, 0] = box_lo0
-    tr_box[row, 1] = box_hi0
-    tr_box[row, 2] = box_lo1
-    tr_box[row, 3] = box_hi1
-    tr_goal_sampled[row] = goal_sampled
-    tr_sample[row, 0] = sx
-    tr_sample[row, 1] = sy
-    tr_nearest[row] = nearest_node
-    tr_new[row, 0] = q_new[0]
-    tr_new[row, 1] = q_new[1]
-    tr_outcome[row] = outcome
-    tr_node[row] = new_index
-    tr_tree[row] = tree_size
-
-
 @nb.njit(cache=True, nogil=True)
-def fuzzy_rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, max_iter,
-                     knots, consts, bounds_mode, min_step, margin,
-                     nodes, parent, cell_next, cell_head, meta, grid,
-                     record, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample,
-                     tr_nearest, tr_new, tr_outcome, tr_node, tr_tree, tr_rule, tr_w):
+def fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, stop,
+                     record, TR):
     """Run Fuzzy-RRT; return ``(success, iterations, index of the last path node or -1)``.
 
-    With ``record`` true, row ``it - 1`` of every ``tr_*`` array describes iteration ``it``;
-    otherwise the ``tr_*`` arrays are never touched (pass 1-row dummies).
+    With ``record`` true, row ``it - 1`` of every trace array in ``TR`` describes iteration
+    ``it``; otherwise ``TR`` (1-row buffers) is never touched. ``stop[0] != 0`` (a wall-clock
+    budget ran out) ends the run.
     """
     state = np.empty(4, dtype=np.uint64)
     seed_state(seed, state)
-    x = np.empty(4, dtype=np.float64)
-    y = np.empty(N_OUTPUTS, dtype=np.float64)
-    dummy_rule = np.empty((N_OUTPUTS, MAX_FIRED), dtype=np.int32)
-    dummy_w = np.empty((N_OUTPUTS, MAX_FIRED), dtype=np.float64)
-    q_near = np.empty(2, dtype=np.float64)
-    q_new = np.empty(2, dtype=np.float64)
-    gx_ws, gy_ws = end_effector(links, base, goal)
+    n_arms = P.arm_first.shape[0] - 1
+    n_out = knots.shape[0]
+    dof = P.start.shape[0]
+    x = np.empty(4 * n_arms, dtype=np.float64)
+    y = np.empty(n_out * n_arms, dtype=np.float64)
+    dummy_rule = np.empty((n_out, MAX_FIRED), dtype=np.int32)
+    dummy_w = np.empty((n_out, MAX_FIRED), dtype=np.float64)
+    box = np.empty(2 * dof, dtype=np.float64)
+    sample = np.empty(dof, dtype=np.float64)
+    q_near = np.empty(dof, dtype=np.float64)
+    q_new = np.empty(dof, dtype=np.float64)
+    goal_ws = np.empty((n_arms, 2), dtype=np.float64)
+    for a in range(n_arms):
+        goal_ws[a, 0], goal_ws[a, 1] = arm_end_effector(P, a, P.goal)
     no_obstacle_dist = knots[0, 3, 4]
+    has_obstacles = P.obstacles.shape[0] > 0 or n_arms > 1
 
-    add_node(nodes, parent, cell_next, cell_head, meta, grid, start[0], start[1], -1)
+    add_node(T, P.start, -1)
     current = 0  # the paper's nearest_node: the start at iteration 1
     for it in range(1, max_iter + 1):
+        if stop[0] != 0:
+            return False, it - 1, -1
         row = it - 1
-        # 1-2. Fuzzy inputs from the current node's end effector.
-        ex, ey = end_effector(links, base, nodes[current])
-        if obstacles.shape[0] > 0:
-            d_obs, a_obs, _ = nearest_obstacle_from_point(ex, ey, obstacles)
-        else:
+        q = T.nodes[current]
+        bias_sum = 0.0
+        step_min = np.inf
+        for a in range(n_arms):
+            # 1-2. Fuzzy inputs from this arm's end effector.
+            ex, ey = arm_end_effector(P, a, q)
             d_obs = no_obstacle_dist
             a_obs = 0.0
-        d_goal, a_goal = direction_and_distance(ex, ey, gx_ws, gy_ws)
-        x[0] = a_goal
-        x[1] = d_goal
-        x[2] = a_obs
-        x[3] = d_obs
-        # 3. Six TSK systems.
-        if record:
-            infer(knots, consts, x, y, tr_rule[row], tr_w[row], True)
-        else:
-            infer(knots, consts, x, y, dummy_rule, dummy_w, False)
-        bias = y[0]
-        off0 = 0.0
-        off1 = 0.0
-        if bounds_mode == BOUNDS_RELATIVE:
-            off0 = nodes[current, 0]
-            off1 = nodes[current, 1]
-        lo0, hi0 = _interval(y[1], y[2], off0, limits[0, 0], limits[0, 1])
-        lo1, hi1 = _interval(y[3], y[4], off1, limits[1, 0], limits[1, 1])
-        step = max(y[5], min_step)
+            if has_obstacles:
+                d, ang, _ = nearest_obstacle_for_arm(P, a, q, ex, ey)
+                if d < np.inf:
+                    d_obs = d
+                    a_obs = ang
+            d_goal, a_goal = direction_and_distance(ex, ey, goal_ws[a, 0], goal_ws[a, 1])
+            xa = x[4 * a:4 * a + 4]
+            ya = y[n_out * a:n_out * (a + 1)]
+            xa[0] = a_goal
+            xa[1] = d_goal
+            xa[2] = a_obs
+            xa[3] = d_obs
+            # 3. The rulebook's systems (goal bias, two bounds per joint, step).
+            if record:
+                infer(knots, consts, xa, ya, TR.rule[row, n_out * a:n_out * (a + 1)],
+                      TR.w[row, n_out * a:n_out * (a + 1)], True)
+            else:
+                infer(knots, consts, xa, ya, dummy_rule, dummy_w, False)
+            bias_sum += ya[0]
+            if ya[n_out - 1] < step_min:
+                step_min = ya[n_out - 1]
+            f = P.arm_first[a]
+            for jl in range(P.arm_first[a + 1] - f):
+                j = f + jl
+                off = 0.0
+                if bounds_mode == BOUNDS_RELATIVE:
+                    off = q[j]
+                lo, hi = _interval(ya[1 + 2 * jl], ya[2 + 2 * jl], off, P.limits[j, 0],
+                                   P.limits[j, 1])
+                box[2 * j] = lo
+                box[2 * j + 1] = hi
+        bias = bias_sum / n_arms
+        step = max(step_min, min_step)
         # 4. Sample.
         goal_sampled = uniform(state) < bias
         if goal_sampled:
-            sx = goal[0]
-            sy = goal[1]
+            for j in range(dof):
+                sample[j] = P.goal[j]
         else:
-            sx = lo0 + uniform(state) * (hi0 - lo0)
-            sy = lo1 + uniform(state) * (hi1 - lo1)
+            for j in range(dof):
+                sample[j] = box[2 * j] + uniform(state) * (box[2 * j + 1] - box[2 * j])
         # 5. Nearest node (carried to the next iteration) and steering.
         from_node = current
-        current = nearest(nodes, cell_next, cell_head, meta, grid, sx, sy)
+        current = nearest(T, sample)
         # 6-7. Steer, certify, grow, try the goal (shared with RRT).
-        outcome, new_index = extend(links, base, radius, obstacles, limits, goal, margin,
-                                    nodes, parent, cell_next, cell_head, meta, grid, current,
-                                    sx, sy, step, q_near, q_new)
+        outcome, new_index = extend(P, T, current, sample, step, q_near, q_new)
         if record:
-            record_iteration(row, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample,
-                             tr_nearest, tr_new, tr_outcome, tr_node, tr_tree, from_node, x, y,
-                             lo0, hi0, lo1, hi1, goal_sampled, sx, sy, current, q_new, outcome,
-                             new_index, meta[0])
+            record_iteration(TR, row, from_node, x, y, box, goal_sampled, sample, current,
+                             q_new, outcome, new_index, T.meta[0])
         if outcome == GOAL_REACHED:
             return True, it, new_index
     return False, max_iter, -1
-
-
-class _TraceBuffers:
-    """Preallocated per-iteration arrays the kernel fills when tracing (1-row dummies if not)."""
-
-    def __init__(self, rows: int):
-        # np.empty, not zeros: the kernel writes every field of every row it records, and
-        # untouched pages of a 10,000-row buffer then cost nothing.
-        self.from_node = np.empty(rows, dtype=np.int64)
-        self.x = np.empty((rows, 4))
-        self.y = np.empty((rows, N_OUTPUTS))
-        self.box = np.empty((rows, 4))
-        self.goal_sampled = np.empty(rows, dtype=np.bool_)
-        self.sample = np.empty((rows, 2))
-        self.nearest = np.empty(rows, dtype=np.int64)
-        self.new = np.empty((rows, 2))
-        self.outcome = np.empty(rows, dtype=np.int8)
-        self.node = np.empty(rows, dtype=np.int64)
-        self.tree = np.empty(rows, dtype=np.int64)
-        self.rule = np.empty((rows, N_OUTPUTS, MAX_FIRED), dtype=np.int32)
-        self.w = np.empty((rows, N_OUTPUTS, MAX_FIRED))
-
-    def args(self):
-        return (self.from_node, self.x, self.y, self.box, self.goal_sampled, self.sample,
-                self.nearest, self.new, self.outcome, self.node, self.tree, self.rule, self.w)
 
 
 def _resolve_rulebook(rulebook):
@@ -243,48 +245,59 @@ def _resolve_rulebook(rulebook):
 
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,
                    trace: bool = False, min_step_deg: float = MIN_STEP_DEG,
-                   margin: float | None = None, clearance_m: float | None = None) -> PlanResult:
+                   margin: float | None = None, clearance_m: float | None = None,
+                   max_time_s: float | None = None) -> PlanResult:
     """Plan with Fuzzy-RRT.
 
     ``rulebook`` is a loaded :class:`~xfuzzy_rrt.fuzzy.rulebook.Rulebook`, a rulebook directory,
-    or ``None`` for the shipped default. With ``trace=True`` the result carries a per-iteration
-    DataFrame (see :mod:`xfuzzy_rrt.planners.trace`). Same inputs and seed, same result.
-    ``clearance_m``/``margin`` as for :func:`~xfuzzy_rrt.planners.rrt.plan_rrt`.
+    or ``None`` for the shipped default; its DOF must fit the arms (:func:`check_rulebook_fits`).
+    With ``trace=True`` the result carries a per-iteration DataFrame (see
+    :mod:`xfuzzy_rrt.planners.trace`). Same inputs and seed, same result (unless the
+    wall-clock budget ``max_time_s`` ends the run). ``clearance_m``/``margin`` as for
+    :func:`~xfuzzy_rrt.planners.rrt.plan_rrt`.
     """
-    check_planar_2dof(scenario)
+    check_dof(scenario)
     margin = planning_margin(scenario, clearance_m, margin)
     check_max_iter(max_iter)
+    params = resolve_params("fuzzy-rrt", max_iter=max_iter, max_time_s=max_time_s,
+                            min_step_deg=min_step_deg)
     rb = _resolve_rulebook(rulebook)
+    check_rulebook_fits(rb, scenario)
     knots, consts = rb.compiled
     mode = kernel_mode(rb)
     kernel = kernel_for(mode)
     a = scenario.arrays()
-    tree = Tree(int(max_iter) + 2, a.limits_deg)
-    buffers = _TraceBuffers(int(max_iter) if trace else 1)
-    t0 = time.perf_counter()
-    ok, iterations, last = kernel(
-        a.links, a.base, a.link_radius, a.obstacles, a.limits_deg, a.start_deg, a.goal_deg,
-        int(seed), int(max_iter), knots, consts, mode, float(min_step_deg), float(margin),
-        tree.nodes, tree.parent, tree.cell_next, tree.cell_head, tree.meta, tree.grid,
-        bool(trace), *buffers.args())
-    wall = time.perf_counter() - t0
+    problem = a.problem(margin)
+    tree = make_tree(int(max_iter) + 2, a.limits_deg)
+    groups = fis_groups(rb, scenario)
+    buffers = make_trace(int(max_iter) if trace else 1, a.dof, knots.shape[0], groups)
+    with StopFlag(max_time_s) as flag:
+        t0 = time.perf_counter()
+        ok, iterations, last = kernel(problem, tree, int(seed), int(max_iter), knots, consts,
+                                      mode, float(min_step_deg), flag.array, bool(trace),
+                                      buffers)
+        wall = time.perf_counter() - t0
     n = int(tree.meta[0])
-    path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, 2))
+    path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, a.dof))
     from xfuzzy_rrt.planners.result import certified_result  # certifies the path (found -> success)
 
+    recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
+                "bounds": rb.bounds_mode, "min_step_deg": float(min_step_deg),
+                "margin_m": float(margin)}
+    if max_time_s is not None:
+        recorded["max_time_s"] = float(params["max_time_s"])
+        recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
     result = certified_result(
         a, margin, bool(ok), scenario=scenario.name, planner="fuzzy-rrt", seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
-        rulebook=rb.name, rulebook_sha256=rb.sha256,
-        params={"max_iter": int(max_iter), "semantics": rb.semantics.name, "bounds": rb.bounds_mode,
-                "min_step_deg": float(min_step_deg), "margin_m": float(margin)},
+        rulebook=rb.name, rulebook_sha256=rb.sha256, params=recorded,
     )
     if trace:
         from xfuzzy_rrt.planners.trace import trace_frame
 
         frame = trace_frame(buffers, int(iterations), tree.nodes[:n], tree.parent[:n], last, rb,
-                            float(min_step_deg))
+                            float(min_step_deg), groups)
         result = dataclasses.replace(result, trace=frame)
     return result

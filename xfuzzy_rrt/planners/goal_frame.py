@@ -20,6 +20,15 @@ outputs mean differ. Each iteration, top to bottom in :func:`goal_frame_kernel`:
 4-7. Nearest node, steer by ``max(step_deg, min_step)``, certified checks, goal connection:
    :func:`xfuzzy_rrt.planners.extend.extend`, exactly as for RRT and the paper's semantics.
 
+**Several joints, several arms.** The inputs are joint-space quantities, so they read the
+joint space of all arms together: distances are Euclidean over every joint, ``clearance_deg``
+counts the other arms' capsules as obstacles and divides by ``sqrt(Σ_arms lever_a^2)`` (a
+Cauchy-Schwarz bound on how fast any point moves, for arm-obstacle and arm-arm distances alike),
+and a rulebook's DOF is the total number of joints. With more than two joints the box's
+"across" part is an ``N``-cube of half-width ``side`` with its component along ``e`` removed
+(``N`` draws, joint by joint), and the traced box is a bounding box of the region (tight only
+along the axes). With two joints every formula and draw is the 2-joint one exactly.
+
 Random draws, in order: one uniform for the goal decision; for a non-goal sample one uniform for
 the uniform-or-box decision, then two (joint 1, joint 2 / along, across).
 
@@ -36,12 +45,12 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.fuzzy.engine import infer
-from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_OUTPUTS
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.collision import clearance_kernel
 from xfuzzy_rrt.planners.extend import extend
-from xfuzzy_rrt.planners.fuzzy_rrt import record_iteration
 from xfuzzy_rrt.planners.result import ACCEPTED, EDGE_BLOCKED, GOAL_REACHED, NODE_IN_COLLISION
 from xfuzzy_rrt.planners.rng import seed_state, uniform
+from xfuzzy_rrt.planners.trace_record import record_iteration
 from xfuzzy_rrt.planners.tree import add_node, nearest
 
 #: Weight of the newest outcome in ``reject_rate`` (about the last ten extensions count).
@@ -67,11 +76,32 @@ def arm_lever(links):
 
 
 @nb.njit(cache=True, nogil=True)
-def goal_frame_kernel(links, base, radius, obstacles, limits, start, goal, seed, max_iter,
-                      knots, consts, unused_mode, min_step, margin,
-                      nodes, parent, cell_next, cell_head, meta, grid,
-                      record, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample,
-                      tr_nearest, tr_new, tr_outcome, tr_node, tr_tree, tr_rule, tr_w):
+def problem_lever(P):
+    """:func:`arm_lever` over all arms: ``sqrt(Σ_arms Σ_j tail_j^2)`` bounds how fast any arm
+    point, and any arm-arm distance, changes per radian of joint-space motion."""
+    total = 0.0
+    for a in range(P.arm_first.shape[0] - 1):
+        f1 = P.arm_first[a + 1]
+        for j in range(P.arm_first[a], f1):
+            tail = 0.0
+            for i in range(j, f1):
+                tail += P.links[i]
+            total += tail * tail
+    return math.sqrt(total)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _joint_dist(a, b):
+    """Euclidean distance, as a chain of ``hypot`` (exactly ``hypot(dx, dy)`` for 2 joints)."""
+    d = 0.0
+    for j in range(a.shape[0]):
+        d = math.hypot(d, b[j] - a[j])
+    return d
+
+
+@nb.njit(cache=True, nogil=True)
+def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step, stop,
+                      record, TR):
     """Run goal-frame Fuzzy-RRT; return ``(success, iterations, index of the last path node or -1)``.
 
     Same signature as :func:`xfuzzy_rrt.planners.fuzzy_rrt.fuzzy_rrt_kernel` (``unused_mode``
@@ -79,33 +109,36 @@ def goal_frame_kernel(links, base, radius, obstacles, limits, start, goal, seed,
     """
     state = np.empty(4, dtype=np.uint64)
     seed_state(seed, state)
+    n_out = knots.shape[0]
+    dof = P.start.shape[0]
     x = np.empty(4, dtype=np.float64)
-    y = np.empty(N_OUTPUTS, dtype=np.float64)
-    dummy_rule = np.empty((N_OUTPUTS, MAX_FIRED), dtype=np.int32)
-    dummy_w = np.empty((N_OUTPUTS, MAX_FIRED), dtype=np.float64)
-    q_near = np.empty(2, dtype=np.float64)
-    q_new = np.empty(2, dtype=np.float64)
-    deg_per_m = math.degrees(1.0) / arm_lever(links)
-    clear_top = knots[0, 2, 4]  # no obstacles: clearance saturates at the top of its range
-    lo0 = limits[0, 0]
-    hi0 = limits[0, 1]
-    lo1 = limits[1, 0]
-    hi1 = limits[1, 1]
+    y = np.empty(n_out, dtype=np.float64)
+    dummy_rule = np.empty((n_out, MAX_FIRED), dtype=np.int32)
+    dummy_w = np.empty((n_out, MAX_FIRED), dtype=np.float64)
+    box = np.empty(2 * dof, dtype=np.float64)
+    sample = np.empty(dof, dtype=np.float64)
+    e = np.empty(dof, dtype=np.float64)
+    q_near = np.empty(dof, dtype=np.float64)
+    q_new = np.empty(dof, dtype=np.float64)
+    goal = P.goal
+    limits = P.limits
+    deg_per_m = math.degrees(1.0) / problem_lever(P)
+    clear_top = knots[0, 2, 4]  # nothing to hit: clearance saturates at the top of its range
+    has_obstacles = P.obstacles.shape[0] > 0 or P.arm_first.shape[0] > 2
 
-    add_node(nodes, parent, cell_next, cell_head, meta, grid, start[0], start[1], -1)
+    add_node(T, P.start, -1)
     current = 0
-    best = math.hypot(goal[0] - start[0], goal[1] - start[1])
+    best = _joint_dist(P.start, goal)
     stagnation = 0.0
     reject = 0.0
     for it in range(1, max_iter + 1):
+        if stop[0] != 0:
+            return False, it - 1, -1
         row = it - 1
-        qx = nodes[current, 0]
-        qy = nodes[current, 1]
-        gx = goal[0] - qx
-        gy = goal[1] - qy
-        d_goal = math.hypot(gx, gy)
-        if obstacles.shape[0] > 0:
-            c = clearance_kernel(links, base, radius, obstacles, nodes[current])
+        q = T.nodes[current]
+        d_goal = _joint_dist(q, goal)
+        if has_obstacles:
+            c = clearance_kernel(P, q)
             c_deg = max(c, 0.0) * deg_per_m
         else:
             c_deg = clear_top
@@ -114,60 +147,78 @@ def goal_frame_kernel(links, base, radius, obstacles, limits, start, goal, seed,
         x[2] = c_deg
         x[3] = reject
         if record:
-            infer(knots, consts, x, y, tr_rule[row], tr_w[row], True)
+            infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
         else:
             infer(knots, consts, x, y, dummy_rule, dummy_w, False)
         step = max(y[5], min_step)
         goal_sampled = uniform(state) < y[0]
         if goal_sampled:
-            sx = goal[0]
-            sy = goal[1]
-            bx0, bx1, by0, by1 = goal[0], goal[0], goal[1], goal[1]
+            for j in range(dof):
+                sample[j] = goal[j]
+                box[2 * j] = goal[j]
+                box[2 * j + 1] = goal[j]
         elif uniform(state) < y[1]:
-            sx = lo0 + uniform(state) * (hi0 - lo0)
-            sy = lo1 + uniform(state) * (hi1 - lo1)
-            bx0, bx1, by0, by1 = lo0, hi0, lo1, hi1
+            for j in range(dof):
+                sample[j] = limits[j, 0] + uniform(state) * (limits[j, 1] - limits[j, 0])
+                box[2 * j] = limits[j, 0]
+                box[2 * j + 1] = limits[j, 1]
         else:
             if d_goal > 0.0:
-                ex = gx / d_goal
-                ey = gy / d_goal
+                for j in range(dof):
+                    e[j] = (goal[j] - q[j]) / d_goal
             else:
-                ex = 1.0
-                ey = 0.0
+                for j in range(dof):
+                    e[j] = 0.0
+                e[0] = 1.0
             ahead = y[2]
             behind = y[3]
             side = y[4]
             a = -behind + uniform(state) * (ahead + behind)
-            b = (2.0 * uniform(state) - 1.0) * side
-            sx = _clamp(qx + a * ex - b * ey, lo0, hi0)
-            sy = _clamp(qy + a * ey + b * ex, lo1, hi1)
-            # bounding box of the rotated box (for traces and drawings), clipped
-            hx = abs(ex) * 0.5 * (ahead + behind) + abs(ey) * side
-            hy = abs(ey) * 0.5 * (ahead + behind) + abs(ex) * side
-            cx = qx + ex * 0.5 * (ahead - behind)
-            cy = qy + ey * 0.5 * (ahead - behind)
-            bx0 = _clamp(cx - hx, lo0, hi0)
-            bx1 = _clamp(cx + hx, lo0, hi0)
-            by0 = _clamp(cy - hy, lo1, hi1)
-            by1 = _clamp(cy + hy, lo1, hi1)
+            if dof == 2:
+                ex = e[0]
+                ey = e[1]
+                b = (2.0 * uniform(state) - 1.0) * side
+                sample[0] = _clamp(q[0] + a * ex - b * ey, limits[0, 0], limits[0, 1])
+                sample[1] = _clamp(q[1] + a * ey + b * ex, limits[1, 0], limits[1, 1])
+                # bounding box of the rotated box (for traces and drawings), clipped
+                hx = abs(ex) * 0.5 * (ahead + behind) + abs(ey) * side
+                hy = abs(ey) * 0.5 * (ahead + behind) + abs(ex) * side
+                cx = q[0] + ex * 0.5 * (ahead - behind)
+                cy = q[1] + ey * 0.5 * (ahead - behind)
+                box[0] = _clamp(cx - hx, limits[0, 0], limits[0, 1])
+                box[1] = _clamp(cx + hx, limits[0, 0], limits[0, 1])
+                box[2] = _clamp(cy - hy, limits[1, 0], limits[1, 1])
+                box[3] = _clamp(cy + hy, limits[1, 0], limits[1, 1])
+            else:
+                # across: a cube of half-width ``side`` with its part along e removed
+                proj = 0.0
+                for j in range(dof):
+                    sample[j] = (2.0 * uniform(state) - 1.0) * side
+                    proj += sample[j] * e[j]
+                e_l1 = 0.0
+                for j in range(dof):
+                    e_l1 += abs(e[j])
+                for j in range(dof):
+                    sample[j] = _clamp(q[j] + a * e[j] + sample[j] - proj * e[j],
+                                       limits[j, 0], limits[j, 1])
+                    h = abs(e[j]) * 0.5 * (ahead + behind) + side * (1.0 + abs(e[j]) * e_l1)
+                    c0 = q[j] + e[j] * 0.5 * (ahead - behind)
+                    box[2 * j] = _clamp(c0 - h, limits[j, 0], limits[j, 1])
+                    box[2 * j + 1] = _clamp(c0 + h, limits[j, 0], limits[j, 1])
         from_node = current
-        current = nearest(nodes, cell_next, cell_head, meta, grid, sx, sy)
-        outcome, new_index = extend(links, base, radius, obstacles, limits, goal, margin,
-                                    nodes, parent, cell_next, cell_head, meta, grid, current,
-                                    sx, sy, step, q_near, q_new)
+        current = nearest(T, sample)
+        outcome, new_index = extend(P, T, current, sample, step, q_near, q_new)
         rejected = 1.0 if (outcome == NODE_IN_COLLISION or outcome == EDGE_BLOCKED) else 0.0
         reject = REJECT_DECAY * reject + (1.0 - REJECT_DECAY) * rejected
         stagnation += 1.0
         if outcome == ACCEPTED:
-            d_new = math.hypot(goal[0] - q_new[0], goal[1] - q_new[1])
+            d_new = _joint_dist(q_new, goal)
             if d_new < best:
                 best = d_new
                 stagnation = 0.0
         if record:
-            record_iteration(row, tr_from, tr_x, tr_y, tr_box, tr_goal_sampled, tr_sample,
-                             tr_nearest, tr_new, tr_outcome, tr_node, tr_tree, from_node, x, y,
-                             bx0, bx1, by0, by1, goal_sampled, sx, sy, current, q_new, outcome,
-                             new_index, meta[0])
+            record_iteration(TR, row, from_node, x, y, box, goal_sampled, sample, current,
+                             q_new, outcome, new_index, T.meta[0])
         if outcome == GOAL_REACHED:
             return True, it, new_index
     return False, max_iter, -1

@@ -74,7 +74,8 @@ from numba import carray
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, config_free, segment_free
 from xfuzzy_rrt.geometry.scenario import Scenario
-from xfuzzy_rrt.planners.checks import check_max_iter, check_planar_2dof, check_positive
+from xfuzzy_rrt.geometry.problem import Problem
+from xfuzzy_rrt.planners.checks import check_dof, check_max_iter, check_positive
 from xfuzzy_rrt.planners.result import PlanResult, certified_result, path_cost_deg
 
 OMPL_PREFIX = "ompl:"
@@ -140,39 +141,56 @@ def ompl_seed(seed: int) -> int:
 # The compiled validity check
 # ----------------------------------------------------------------------------------------------
 
-_HEADER = 6  # [dof, obstacles, link_radius, margin, base_x, base_y]
+_HEADER = 4  # [dof, obstacles, arms, margin]
 
 
 def pack_scenario(arrays, margin: float) -> np.ndarray:
-    """One contiguous float64 buffer the validity ``cfunc`` reads through a raw pointer."""
+    """The problem as one contiguous float64 buffer the validity ``cfunc`` reads through a raw
+    pointer: ``[dof, obstacles, arms, margin, arm_first (arms + 1), bases (2 arms), radii
+    (arms), links (dof), limits (2 dof), obstacles (5 per obstacle)]``."""
     dof = arrays.links.shape[0]
     m = arrays.obstacles.shape[0]
+    n_arms = arrays.n_arms
     return np.ascontiguousarray(np.concatenate([
-        [float(dof), float(m), arrays.link_radius, float(margin)], arrays.base, arrays.links,
+        [float(dof), float(m), float(n_arms), float(margin)],
+        arrays.arm_first.astype(np.float64), arrays.bases.ravel(), arrays.radii, arrays.links,
         arrays.limits_deg.ravel(), arrays.obstacles.ravel(),
     ]).astype(np.float64))
 
 
-@nb.cfunc(nb.types.boolean(nb.types.float64, nb.types.float64, nb.types.voidptr), cache=True)
-def _valid_cfunc(q0, q1, ptr):
-    """Compiled 2-DOF check over the :func:`pack_scenario` buffer at ``ptr``."""
+@nb.cfunc(nb.types.boolean(nb.types.voidptr, nb.types.voidptr), cache=True)
+def _valid_cfunc(qptr, ptr):
+    """Compiled check of the configuration at ``qptr`` in the :func:`pack_scenario` buffer at
+    ``ptr``: the planners' own :func:`~xfuzzy_rrt.geometry.collision.config_free`."""
     head = carray(ptr, (_HEADER,), dtype=np.float64)
     dof = int(head[0])
     m = int(head[1])
-    data = carray(ptr, (_HEADER + 3 * dof + 5 * m,), dtype=np.float64)
-    links = data[_HEADER:_HEADER + dof]
-    limits = data[_HEADER + dof:_HEADER + 3 * dof].reshape((dof, 2))
-    obstacles = data[_HEADER + 3 * dof:].reshape((m, 5))
-    q = np.empty(2, dtype=np.float64)
-    q[0] = q0
-    q[1] = q1
-    return config_free(links, data[4:6], head[2], obstacles, limits, q, head[3])
+    n_arms = int(head[2])
+    size = _HEADER + (n_arms + 1) + 3 * n_arms + 3 * dof + 5 * m
+    data = carray(ptr, (size,), dtype=np.float64)
+    k = _HEADER
+    arm_first = np.empty(n_arms + 1, dtype=np.int64)
+    for a in range(n_arms + 1):
+        arm_first[a] = int(data[k + a])
+    k += n_arms + 1
+    bases = data[k:k + 2 * n_arms].reshape((n_arms, 2))
+    k += 2 * n_arms
+    radii = data[k:k + n_arms]
+    k += n_arms
+    links = data[k:k + dof]
+    k += dof
+    limits = data[k:k + 2 * dof].reshape((dof, 2))
+    k += 2 * dof
+    obstacles = data[k:k + 5 * m].reshape((m, 5))
+    q = carray(qptr, (dof,), dtype=np.float64)
+    P = Problem(links, arm_first, bases, radii, obstacles, limits, q, q, head[3])
+    return config_free(P, q, head[3])
 
 
 def validity_cfunc():
-    """The compiled check ``(q0_deg, q1_deg, buffer*) -> bool`` as a ctypes function."""
+    """The compiled check ``(q_deg*, buffer*) -> bool`` as a ctypes function."""
     fn = _valid_cfunc.ctypes
-    fn.argtypes = [ctypes.c_double, ctypes.c_double, ctypes.c_void_p]
+    fn.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
     fn.restype = ctypes.c_bool
     return fn
 
@@ -180,14 +198,20 @@ def validity_cfunc():
 def make_validity_callback(arrays, margin: float = CERT_MARGIN_M):
     """A Python callable ``state -> bool`` for OMPL that runs our compiled check.
 
-    The buffer is bound as a default argument so it lives as long as the callback.
+    The buffers are bound as default arguments so they live as long as the callback.
     """
     buffer = pack_scenario(arrays, margin)
     fn = validity_cfunc()
     address = buffer.ctypes.data
+    dof = arrays.links.shape[0]
+    q = np.empty(dof, dtype=np.float64)
+    q_address = q.ctypes.data
+    joints = range(dof)
 
-    def is_valid(state, _fn=fn, _address=address, _buffer=buffer):
-        return _fn(state[0], state[1], _address)
+    def is_valid(state, _fn=fn, _address=address, _buffer=buffer, _q=q, _qa=q_address):
+        for j in joints:
+            _q[j] = state[j]
+        return _fn(_qa, _address)
 
     return is_valid
 
@@ -209,7 +233,7 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
     """
     ob, og, ou = import_ompl("--planner")
     bare = check_ompl_planner(planner, "--planner")
-    check_planar_2dof(scenario)
+    check_dof(scenario)
     check_max_iter(max_iter)
     check_positive("step_deg", step_deg)
     if not 0.0 <= goal_bias <= 1.0:

@@ -16,14 +16,15 @@ import time
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.scenario import Scenario
-from xfuzzy_rrt.planners.checks import check_max_iter, check_planar_2dof, check_positive
+from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
 from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.params import resolve_params
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
-from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path, nearest
+from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
+from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest
 
 DEFAULT_STEP_DEG = 10.0
 DEFAULT_GOAL_BIAS = 0.05
@@ -31,24 +32,27 @@ DEFAULT_MAX_ITER = 10_000
 
 
 @nb.njit(cache=True, nogil=True)
-def rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, max_iter, step,
-               goal_bias, margin, nodes, parent, cell_next, cell_head, meta, grid):
-    """Run RRT; return ``(success, iterations, index of the last path node or -1)``."""
+def rrt_kernel(P, T, seed, max_iter, step, goal_bias, stop):
+    """Run RRT on problem ``P`` growing tree ``T``; return ``(success, iterations, index of the
+    last path node or -1)``. ``stop[0] != 0`` (a wall-clock budget ran out) ends the run."""
     state = np.empty(4, dtype=np.uint64)
     seed_state(seed, state)
-    q_near = np.empty(2, dtype=np.float64)
-    q_new = np.empty(2, dtype=np.float64)
-    add_node(nodes, parent, cell_next, cell_head, meta, grid, start[0], start[1], -1)
+    dof = P.start.shape[0]
+    sample = np.empty(dof, dtype=np.float64)
+    q_near = np.empty(dof, dtype=np.float64)
+    q_new = np.empty(dof, dtype=np.float64)
+    add_node(T, P.start, -1)
     for it in range(1, max_iter + 1):
+        if stop[0] != 0:
+            return False, it - 1, -1
         if uniform(state) < goal_bias:
-            sx = goal[0]
-            sy = goal[1]
+            for j in range(dof):
+                sample[j] = P.goal[j]
         else:
-            sx = limits[0, 0] + uniform(state) * (limits[0, 1] - limits[0, 0])
-            sy = limits[1, 0] + uniform(state) * (limits[1, 1] - limits[1, 0])
-        ni = nearest(nodes, cell_next, cell_head, meta, grid, sx, sy)
-        outcome, k = extend(links, base, radius, obstacles, limits, goal, margin, nodes, parent,
-                            cell_next, cell_head, meta, grid, ni, sx, sy, step, q_near, q_new)
+            for j in range(dof):
+                sample[j] = P.limits[j, 0] + uniform(state) * (P.limits[j, 1] - P.limits[j, 0])
+        ni = nearest(T, sample)
+        outcome, k = extend(P, T, ni, sample, step, q_near, q_new)
         if outcome == GOAL_REACHED:
             return True, it, k
     return False, max_iter, -1
@@ -56,33 +60,40 @@ def rrt_kernel(links, base, radius, obstacles, limits, start, goal, seed, max_it
 
 def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER,
              step_deg: float = DEFAULT_STEP_DEG, goal_bias: float = DEFAULT_GOAL_BIAS,
-             margin: float | None = None, clearance_m: float | None = None) -> PlanResult:
-    """Plan with RRT. Same inputs and seed give the same result (``wall_s`` aside).
+             margin: float | None = None, clearance_m: float | None = None,
+             max_time_s: float | None = None) -> PlanResult:
+    """Plan with RRT in the joint space of every arm. Same inputs and seed give the same result
+    (``wall_s`` aside, and unless the wall-clock budget ``max_time_s`` ends the run).
 
     ``clearance_m``: the certified clearance (m; default the scenario's ``clearance_m``, else
     0); ``margin``: an explicit kernel margin instead (see ``geometry/clearance.py``).
     """
-    check_planar_2dof(scenario)
+    check_dof(scenario)
     margin = planning_margin(scenario, clearance_m, margin)
-    check_positive("step_deg", step_deg)
-    if not 0.0 <= goal_bias <= 1.0:
-        raise InputError("goal_bias", f"must lie in [0, 1], got {goal_bias!r}")
     check_max_iter(max_iter)
+    params = resolve_params("rrt", max_iter=max_iter, max_time_s=max_time_s,
+                            step_deg=step_deg, goal_bias=goal_bias)
+    max_iter = params["max_iter"]
     a = scenario.arrays()
-    tree = Tree(int(max_iter) + 2, a.limits_deg)
-    t0 = time.perf_counter()
-    ok, iterations, last = rrt_kernel(
-        a.links, a.base, a.link_radius, a.obstacles, a.limits_deg, a.start_deg, a.goal_deg,
-        int(seed), int(max_iter), float(step_deg), float(goal_bias), float(margin),
-        tree.nodes, tree.parent, tree.cell_next, tree.cell_head, tree.meta, tree.grid)
-    wall = time.perf_counter() - t0
+    problem = a.problem(margin)
+    tree = make_tree(int(max_iter) + 2, a.limits_deg)
+    with StopFlag(max_time_s) as flag:
+        t0 = time.perf_counter()
+        ok, iterations, last = rrt_kernel(problem, tree, int(seed), int(max_iter),
+                                          float(params["step_deg"]),
+                                          float(params["goal_bias"]), flag.array)
+        wall = time.perf_counter() - t0
     n = int(tree.meta[0])
-    path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, 2))
+    path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, a.dof))
+    recorded = {"step_deg": float(params["step_deg"]), "goal_bias": float(params["goal_bias"]),
+                "max_iter": int(max_iter), "margin_m": float(margin)}
+    if max_time_s is not None:
+        recorded["max_time_s"] = float(params["max_time_s"])
+        recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
     return certified_result(
         a, margin, bool(ok), scenario=scenario.name, planner="rrt", seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
-        params={"step_deg": float(step_deg), "goal_bias": float(goal_bias),
-                "max_iter": int(max_iter), "margin_m": float(margin)},
+        params=recorded,
     )

@@ -97,7 +97,7 @@ def _dist(a, b):
 
 
 @nb.njit(cache=True, nogil=True)
-def shortcut_kernel(links, base, radius, obstacles, limits, path, seed, attempts, margin):
+def shortcut_kernel(P, path, seed, attempts, margin):
     """Return ``(buffer, n)``: the shortened path is ``buffer[:n]`` (see module docstring)."""
     dof = path.shape[1]
     cap = path.shape[0] + 2 * attempts + 2
@@ -133,15 +133,15 @@ def shortcut_kernel(links, base, radius, obstacles, limits, path, seed, attempts
         old = (cum[i1 + 1] - t1) + (cum[i2] - cum[i1 + 1]) + (t2 - cum[i2])
         if not _dist(p1, p2) < old - _MIN_GAIN_DEG:
             continue
-        if not (within_limits(limits, p1) and within_limits(limits, p2)):
+        if not (within_limits(P.limits, p1) and within_limits(P.limits, p2)):
             continue
-        if not edge_free(links, base, radius, obstacles, p1, p2, margin):
+        if not edge_free(P, p1, p2, margin):
             continue
         keep1 = not _same(p1, cur[i1])
         keep2 = not _same(p2, cur[i2 + 1])
-        if keep1 and not edge_free(links, base, radius, obstacles, cur[i1], p1, margin):
+        if keep1 and not edge_free(P, cur[i1], p1, margin):
             continue
-        if keep2 and not edge_free(links, base, radius, obstacles, p2, cur[i2 + 1], margin):
+        if keep2 and not edge_free(P, p2, cur[i2 + 1], margin):
             continue
         m = 0
         for i in range(i1 + 1):
@@ -179,9 +179,8 @@ def shortcut_path(arrays, path_deg, seed: int, attempts: int = DEFAULT_ATTEMPTS,
         raise InputError("path", "contains non-finite angles")
     if path.shape[0] < 3 or attempts == 0:
         return path.copy()
-    buf, n = shortcut_kernel(arrays.links, arrays.base, arrays.link_radius, arrays.obstacles,
-                             arrays.limits_deg, path, int(seed),
-                             int(attempts), float(margin))
+    buf, n = shortcut_kernel(arrays.problem(margin), path, int(seed), int(attempts),
+                             float(margin))
     out = buf[:n].copy()
     if path_cost_deg(out) > path_cost_deg(path):  # rounding guard: never return a longer path
         return path.copy()

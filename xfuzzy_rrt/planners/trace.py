@@ -17,6 +17,11 @@ One row per iteration (``iteration`` = 1..iterations). Columns, in this order:
   ``rulebook``, ``rulebook_sha256`` (which rulebook made these decisions);
 - with a rulebook of another semantics (e.g. ``goal-frame``) the input and output columns carry
   that semantics' names instead, and the box is the bounding box of its sampling region;
+- with more joints, one ``from_q<j>_deg``, ``box_q<j>_lo``/``_hi``, ``sample_q<j>_deg`` and
+  ``new_q<j>_deg`` per joint ``j`` = 1..dof (all arms, arm after arm);
+- with several arms and the paper's semantics (one fuzzy evaluation per arm) every input,
+  output, rule and strength column is prefixed ``arm<a>_`` (``arm1_goal_bias``, ...);
+  ``step_used_deg`` is then the smallest arm's step, as the planner used it;
 - per FIS ``<output>_rule_<k>`` for k = 0..15, then per FIS ``<output>_strength_<k>``: the
   rules that fired (index into the rulebook's 625, ascending; -1 for unused slots) and their
   normalised strengths (summing to 1).
@@ -47,14 +52,24 @@ _OUTCOME_DTYPE = pd.CategoricalDtype([OUTCOME_NAMES[k] for k in sorted(OUTCOME_N
 _INT_HEAD = _columns(["iteration", "from_node", "nearest_node", "new_node", "tree_size"])
 
 
-@functools.lru_cache(maxsize=8)
-def _column_blocks(inputs: tuple[str, ...], outputs: tuple[str, ...]):
+@functools.lru_cache(maxsize=32)
+def _column_blocks(inputs: tuple[str, ...], outputs: tuple[str, ...], dof: int = 2,
+                   groups: int = 1):
     """Precomputed column indexes of one semantics (float head, rule and strength blocks)."""
-    float_head = _columns(["from_q1_deg", "from_q2_deg", *inputs, *outputs, "box_q1_lo",
-                           "box_q1_hi", "box_q2_lo", "box_q2_hi", "step_used_deg",
-                           "sample_q1_deg", "sample_q2_deg", "new_q1_deg", "new_q2_deg"])
-    rules = _columns([c for out in outputs for c in fired_columns(out)[0]])
-    strengths = _columns([c for out in outputs for c in fired_columns(out)[1]])
+    def prefixed(names):
+        if groups == 1:
+            return list(names)
+        return [f"arm{g + 1}_{n}" for g in range(groups) for n in names]
+
+    joints = range(1, dof + 1)
+    box = [c for j in joints for c in (f"box_q{j}_lo", f"box_q{j}_hi")]
+    float_head = _columns([*(f"from_q{j}_deg" for j in joints), *prefixed(inputs),
+                           *prefixed(outputs), *box, "step_used_deg",
+                           *(f"sample_q{j}_deg" for j in joints),
+                           *(f"new_q{j}_deg" for j in joints)])
+    fis = prefixed(outputs)
+    rules = _columns([c for out in fis for c in fired_columns(out)[0]])
+    strengths = _columns([c for out in fis for c in fired_columns(out)[1]])
     return float_head, rules, strengths
 
 
@@ -64,7 +79,7 @@ def _constant_dtype(value: str) -> pd.CategoricalDtype:
 
 
 def trace_frame(buffers, iterations: int, nodes: np.ndarray, parent: np.ndarray, last: int,
-                rulebook, min_step_deg: float) -> pd.DataFrame:
+                rulebook, min_step_deg: float, groups: int = 1) -> pd.DataFrame:
     """Assemble the DataFrame from the kernel's buffers and the final tree.
 
     Built from a few homogeneous 2-D blocks with precomputed column indexes, in the final
@@ -85,9 +100,12 @@ def trace_frame(buffers, iterations: int, nodes: np.ndarray, parent: np.ndarray,
 
     int_head = np.stack([np.arange(1, n + 1, dtype=np.int64), from_node, buffers.nearest[:n],
                          new_node, buffers.tree[:n]], axis=1)
+    n_out = buffers.y.shape[1] // groups
+    # the step is each group's last output; the planner uses the smallest
+    steps = buffers.y[:n, n_out - 1::n_out].min(axis=1)
     float_head = np.concatenate([
         nodes[from_node], buffers.x[:n], buffers.y[:n], buffers.box[:n],
-        np.maximum(buffers.y[:n, -1], min_step_deg)[:, None],  # the step is the last output
+        np.maximum(steps, min_step_deg)[:, None],
         buffers.sample[:n], buffers.new[:n],
     ], axis=1)
     zeros = np.zeros(n, dtype=np.int8)
@@ -101,7 +119,8 @@ def trace_frame(buffers, iterations: int, nodes: np.ndarray, parent: np.ndarray,
         "rulebook_sha256": pd.Categorical.from_codes(
             zeros, dtype=_constant_dtype(rulebook.sha256), validate=False),
     })
-    float_cols, rule_cols, strength_cols = _column_blocks(rulebook.inputs, rulebook.outputs)
+    float_cols, rule_cols, strength_cols = _column_blocks(
+        tuple(rulebook.inputs), tuple(rulebook.outputs), int(nodes.shape[1]), int(groups))
     return pd.concat([
         pd.DataFrame(int_head, columns=_INT_HEAD, copy=False),
         pd.DataFrame(float_head, columns=float_cols, copy=False),

@@ -1,21 +1,31 @@
-"""The search tree shared by the planners: node storage and nearest-neighbour queries.
+"""The search tree shared by the planners: node storage and exact nearest-neighbour queries.
 
-Nodes live in preallocated arrays (``nodes[cap, 2]`` in degrees, ``parent[cap]``), so the
-compiled planner loop never allocates. Nearest-neighbour search uses a uniform grid over the
-joint box with one linked list per cell, searched in Chebyshev rings around the query's cell
-and only within the bounding box of occupied cells. A ring search stops once the best distance
-found is strictly below the smallest distance any unvisited ring could hold, so the answer is
-*exactly* the brute-force one, ties included (lowest node index wins), while the cost per query
-stays roughly constant as the tree grows to 10,000 nodes instead of growing linearly.
+Nodes live in preallocated arrays (``nodes[cap, dof]`` in degrees, ``parent[cap]``), so the
+compiled planner loop never allocates. Nearest-neighbour search is *exact* (the brute-force
+answer, ties to the lowest node index) and must not make long runs quadratic:
 
-Integer bookkeeping is an ``int64`` array ``meta``:
-``[n_nodes, ncx, ncy, bx0, by0, bx1, by1]`` (grid size and occupied cell bounding box), and the
-grid geometry a ``float64`` array ``grid = [lo0, lo1, cell]``.
+- **2 joints: a uniform grid** over the joint box with one linked list per cell, searched in
+  Chebyshev rings around the query's cell and only within the bounding box of occupied cells.
+  A ring search stops once the best distance found is strictly below the smallest distance any
+  unvisited ring could hold, so the cost per query stays roughly constant as the tree grows to
+  10,000 nodes.
+- **3 joints and more: an incremental k-d tree.** A grid's cell count grows like 36^N; a k-d
+  tree splits on joint ``depth mod N`` as nodes arrive (RRT inserts in a spatially spread
+  order, so the tree stays shallow in practice) and a query descends to the query's leaf,
+  then visits the far side of a split only when the split plane is not farther than the best
+  distance found (``>=``, not ``>``: equal distances must be seen for the lowest-index tie
+  rule). Expected cost per query grows like log n instead of n.
+
+The arrays travel together as one :class:`TreeArrays` record (a numba named tuple). Integer
+grid bookkeeping is ``meta = [n_nodes, ncx, ncy, bx0, by0, bx1, by1]`` (grid size and occupied
+cell bounding box; ``n_nodes`` is used for every dimension) and the grid geometry
+``grid = [lo0, lo1, cell]``.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
@@ -26,21 +36,55 @@ CELL_DEG = 10.0
 N_NODES, NCX, NCY, BX0, BY0, BX1, BY1 = range(7)
 
 
-class Tree:
-    """Preallocated tree arrays (created in Python once per plan, filled by compiled code)."""
+class TreeArrays(NamedTuple):
+    """Preallocated tree arrays (created in Python once per plan, filled by compiled code).
 
-    def __init__(self, capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG):
-        limits_deg = np.asarray(limits_deg, dtype=np.float64)
-        if limits_deg.shape != (2, 2):
-            raise ValueError("the grid tree supports 2 joints")
-        self.nodes = np.zeros((capacity, 2), dtype=np.float64)
-        self.parent = np.full(capacity, -1, dtype=np.int64)
-        self.cell_next = np.full(capacity, -1, dtype=np.int64)
+    ``cell_next``/``cell_head``/``grid`` serve the 2-joint grid, ``kd_left``/``kd_right``/
+    ``kd_axis``/``stack`` the k-d tree; the unused structure's arrays have length 1.
+    """
+
+    nodes: np.ndarray
+    parent: np.ndarray
+    cell_next: np.ndarray
+    cell_head: np.ndarray
+    meta: np.ndarray
+    grid: np.ndarray
+    kd_left: np.ndarray
+    kd_right: np.ndarray
+    kd_axis: np.ndarray
+    stack: np.ndarray
+    stack_lb: np.ndarray
+
+
+def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG) -> TreeArrays:
+    """Empty tree for ``capacity`` nodes in the joint box ``limits_deg`` (``[dof, 2]``)."""
+    limits_deg = np.asarray(limits_deg, dtype=np.float64)
+    if limits_deg.ndim != 2 or limits_deg.shape[1] != 2 or limits_deg.shape[0] < 2:
+        raise ValueError("the tree needs joint limits of shape [dof >= 2, 2]")
+    dof = limits_deg.shape[0]
+    nodes = np.zeros((capacity, dof), dtype=np.float64)
+    parent = np.full(capacity, -1, dtype=np.int64)
+    if dof == 2:
         ncx = max(1, int(math.ceil((limits_deg[0, 1] - limits_deg[0, 0]) / cell_deg)))
         ncy = max(1, int(math.ceil((limits_deg[1, 1] - limits_deg[1, 0]) / cell_deg)))
-        self.cell_head = np.full(ncx * ncy, -1, dtype=np.int64)
-        self.meta = np.array([0, ncx, ncy, ncx, ncy, -1, -1], dtype=np.int64)
-        self.grid = np.array([limits_deg[0, 0], limits_deg[1, 0], cell_deg], dtype=np.float64)
+        cell_next = np.full(capacity, -1, dtype=np.int64)
+        cell_head = np.full(ncx * ncy, -1, dtype=np.int64)
+        kd = 1
+    else:
+        ncx = ncy = 1
+        cell_next = np.full(1, -1, dtype=np.int64)
+        cell_head = np.full(1, -1, dtype=np.int64)
+        kd = capacity
+    meta = np.array([0, ncx, ncy, ncx, ncy, -1, -1], dtype=np.int64)
+    grid = np.array([limits_deg[0, 0], limits_deg[1, 0], cell_deg], dtype=np.float64)
+    return TreeArrays(nodes, parent, cell_next, cell_head, meta, grid,
+                      np.full(kd, -1, dtype=np.int64), np.full(kd, -1, dtype=np.int64),
+                      np.zeros(kd, dtype=np.int64), np.zeros(kd, dtype=np.int64),
+                      np.zeros(kd, dtype=np.float64))
+
+
+#: Old name, kept for callers that build a tree by hand.
+Tree = make_tree
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -59,17 +103,12 @@ def _cell_of(grid, meta, x, y):
 
 
 @nb.njit(cache=True, nogil=True)
-def add_node(nodes, parent, cell_next, cell_head, meta, grid, x, y, parent_index):
-    """Append node (x, y) with its parent; return its index."""
-    i = meta[N_NODES]
-    nodes[i, 0] = x
-    nodes[i, 1] = y
-    parent[i] = parent_index
+def _grid_add(cell_next, cell_head, meta, grid, i, x, y):
+    """File node ``i`` at (x, y) in its grid cell."""
     cx, cy = _cell_of(grid, meta, x, y)
     c = cy * meta[NCX] + cx
     cell_next[i] = cell_head[c]
     cell_head[c] = i
-    meta[N_NODES] = i + 1
     if cx < meta[BX0]:
         meta[BX0] = cx
     if cx > meta[BX1]:
@@ -78,7 +117,6 @@ def add_node(nodes, parent, cell_next, cell_head, meta, grid, x, y, parent_index
         meta[BY0] = cy
     if cy > meta[BY1]:
         meta[BY1] = cy
-    return i
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -96,7 +134,7 @@ def _scan_cell(nodes, cell_next, cell_head, c, x, y, best_d2, best_i):
 
 
 @nb.njit(cache=True, nogil=True)
-def nearest(nodes, cell_next, cell_head, meta, grid, x, y):
+def _grid_nearest(nodes, cell_next, cell_head, meta, grid, x, y):
     """Index of the node nearest to (x, y) (Euclidean, degrees); lowest index on ties."""
     ncx = meta[NCX]
     cx, cy = _cell_of(grid, meta, x, y)
@@ -139,14 +177,119 @@ def nearest(nodes, cell_next, cell_head, meta, grid, x, y):
 
 
 @nb.njit(cache=True, nogil=True)
-def nearest_brute(nodes, n, x, y):
-    """Linear scan; the reference the grid search is tested against."""
+def _kd_add(T, i):
+    """Hang node ``i`` under the k-d tree (split axis = depth mod dof; ties go right)."""
+    dof = T.nodes.shape[1]
+    T.kd_left[i] = -1  # a reused tree may hold links from an earlier run
+    T.kd_right[i] = -1
+    if i == 0:
+        T.kd_axis[0] = 0
+        return
+    j = 0
+    while True:
+        ax = T.kd_axis[j]
+        if T.nodes[i, ax] < T.nodes[j, ax]:
+            nxt = T.kd_left[j]
+            if nxt < 0:
+                T.kd_left[j] = i
+                break
+        else:
+            nxt = T.kd_right[j]
+            if nxt < 0:
+                T.kd_right[j] = i
+                break
+        j = nxt
+    ax = T.kd_axis[j] + 1
+    T.kd_axis[i] = ax if ax < dof else 0
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _d2(nodes, i, q):
+    d2 = 0.0
+    for j in range(q.shape[0]):
+        dj = nodes[i, j] - q[j]
+        d2 += dj * dj
+    return d2
+
+
+@nb.njit(cache=True, nogil=True)
+def _kd_nearest(T, q):
+    """Exact nearest node (lowest index on ties) by depth-first k-d search with pruning."""
+    nodes = T.nodes
+    stack = T.stack
+    stack_lb = T.stack_lb
+    best_d2 = np.inf
+    best_i = -1
+    top = 0
+    stack[0] = 0
+    stack_lb[0] = 0.0
+    top = 1
+    while top > 0:
+        top -= 1
+        i = stack[top]
+        lb = stack_lb[top]
+        if lb > best_d2:
+            continue
+        while i >= 0:
+            d2 = _d2(nodes, i, q)
+            if d2 < best_d2 or (d2 == best_d2 and i < best_i):
+                best_d2 = d2
+                best_i = i
+            ax = T.kd_axis[i]
+            diff = q[ax] - nodes[i, ax]
+            if diff < 0.0:
+                near = T.kd_left[i]
+                far = T.kd_right[i]
+            else:
+                near = T.kd_right[i]
+                far = T.kd_left[i]
+            if far >= 0:
+                far_lb = max(lb, diff * diff)
+                if far_lb <= best_d2:
+                    stack[top] = far
+                    stack_lb[top] = far_lb
+                    top += 1
+            i = near
+    return best_i
+
+
+@nb.njit(cache=True, nogil=True)
+def add_node(T, q, parent_index):
+    """Append configuration ``q`` with its parent; return its index."""
+    i = T.meta[N_NODES]
+    for j in range(q.shape[0]):
+        T.nodes[i, j] = q[j]
+    T.parent[i] = parent_index
+    if T.nodes.shape[1] == 2:
+        _grid_add(T.cell_next, T.cell_head, T.meta, T.grid, i, q[0], q[1])
+    else:
+        _kd_add(T, i)
+    T.meta[N_NODES] = i + 1
+    return i
+
+
+@nb.njit(cache=True, nogil=True)
+def nearest(T, q):
+    """Index of the node nearest to ``q`` (Euclidean, degrees); lowest index on ties."""
+    if T.nodes.shape[1] == 2:
+        return _grid_nearest(T.nodes, T.cell_next, T.cell_head, T.meta, T.grid, q[0], q[1])
+    return _kd_nearest(T, q)
+
+
+@nb.njit(cache=True, nogil=True)
+def reset_tree(T, meta0):
+    """Empty ``T`` for the next run (``meta0``: its ``meta`` when new); no allocation."""
+    T.meta[:] = meta0
+    T.cell_head[:] = -1
+
+
+@nb.njit(cache=True, nogil=True)
+def nearest_brute(nodes, n, q):
+    """Linear scan; the reference the grid and k-d searches are tested against."""
     best_d2 = np.inf
     best_i = -1
     for i in range(n):
-        dx = nodes[i, 0] - x
-        dy = nodes[i, 1] - y
-        d2 = dx * dx + dy * dy
+        d2 = _d2(nodes, i, q)
         if d2 < best_d2:
             best_d2 = d2
             best_i = i
@@ -155,18 +298,18 @@ def nearest_brute(nodes, n, x, y):
 
 @nb.njit(cache=True, nogil=True)
 def extract_path(nodes, parent, last):
-    """Configurations from the root to node ``last`` (``[k, 2]``)."""
+    """Configurations from the root to node ``last`` (``[k, dof]``)."""
     k = 0
     i = last
     while i >= 0:
         k += 1
         i = parent[i]
-    out = np.empty((k, 2), dtype=np.float64)
+    out = np.empty((k, nodes.shape[1]), dtype=np.float64)
     i = last
     j = k - 1
     while i >= 0:
-        out[j, 0] = nodes[i, 0]
-        out[j, 1] = nodes[i, 1]
+        for d in range(nodes.shape[1]):
+            out[j, d] = nodes[i, d]
         j -= 1
         i = parent[i]
     return out

@@ -136,13 +136,13 @@ def cspace_grid(scenario: Scenario, res_deg: float = 2.0) -> CSpaceGrid:
     q2 = _axis(lo2, hi2, res_deg)
     flags = np.zeros((q2.size, q1.size), dtype=bool)
     if a.obstacles.shape[0]:
+        problem = a.problem(0.0)
         q = np.empty(2, dtype=np.float64)
         for j in range(q2.size):
             q[1] = q2[j]
             for i in range(q1.size):
                 q[0] = q1[i]
-                flags[j, i] = clearance_kernel(a.links, a.base, a.link_radius, a.obstacles,
-                                               q) <= 0.0
+                flags[j, i] = clearance_kernel(problem, q) <= 0.0
     return CSpaceGrid(q1_deg=q1, q2_deg=q2, collision=flags, res_deg=float(res_deg))
 
 

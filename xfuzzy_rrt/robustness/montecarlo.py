@@ -43,7 +43,9 @@ import numpy as np
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.clearance import min_clearance_kernel
-from xfuzzy_rrt.geometry.path_check import signed_clearance_kernel
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
+from xfuzzy_rrt.geometry.problem import with_obstacles
+from xfuzzy_rrt.geometry.signed import signed_clearance_kernel
 
 DISTRIBUTIONS = ("normal", "uniform")
 #: Tolerance (m) of each trial's minimum clearance (whether it is <= 0 is decided exactly).
@@ -120,15 +122,14 @@ def perturb_paths(path: np.ndarray, n: int, p: Perturbation,
 
 
 @nb.njit(cache=True, nogil=True, parallel=True)
-def trials_kernel(links, base, radius, obstacles_t, paths_t, tol, max_evals,
-                  value, lower, hit):
+def trials_kernel(P, obstacles_t, paths_t, tol, max_evals, value, lower, hit):
     """Per trial: exact min signed clearance, its lower bound, and the obstacle it is to."""
     n = obstacles_t.shape[0]
     m = obstacles_t.shape[1]
     for t in nb.prange(n):
         path = paths_t[t]
         obs = obstacles_t[t]
-        v, seg, s, lb = min_clearance_kernel(links, base, radius, obs, path, tol, max_evals,
+        v, seg, s, lb = min_clearance_kernel(with_obstacles(P, obs), path, tol, max_evals,
                                              True)
         value[t] = v
         lower[t] = lb
@@ -140,7 +141,7 @@ def trials_kernel(links, base, radius, obstacles_t, paths_t, tol, max_evals,
                 q[d] = path[seg, d] + s * (path[j, d] - path[seg, d])
             best = np.inf
             for o in range(m):
-                c = signed_clearance_kernel(links, base, radius, obs[o:o + 1], q)
+                c = signed_clearance_kernel(with_obstacles(P, obs[o:o + 1]), q)
                 if c < best:
                     best = c
                     hit[t] = o
@@ -217,12 +218,12 @@ def path_robustness(arrays, path_deg, perturbation: Perturbation, trials: int = 
                              f"{nb.config.NUMBA_NUM_THREADS}], got {workers!r}")
         nb.set_num_threads(workers)
     try:
-        trials_kernel(arrays.links, arrays.base, float(arrays.link_radius), obs_t, paths_t,
-                      TRIAL_TOL_M, TRIAL_MAX_EVALS, value, lower, hit)
+        trials_kernel(arrays.problem(CERT_MARGIN_M), obs_t, paths_t, TRIAL_TOL_M,
+                      TRIAL_MAX_EVALS, value, lower, hit)
     finally:
         nb.set_num_threads(previous)
-    nominal = min_clearance_kernel(arrays.links, arrays.base, float(arrays.link_radius),
-                                   obstacles, path, 1e-9, TRIAL_MAX_EVALS, True)[0]
+    nominal = min_clearance_kernel(arrays.problem(CERT_MARGIN_M)._replace(obstacles=obstacles),
+                                   path, 1e-9, TRIAL_MAX_EVALS, True)[0]
     collided = value <= 0.0
     k = int(collided.sum())
     lo, hi = clopper_pearson(k, int(trials))

@@ -93,8 +93,9 @@ def execute_once(scenario, planner: str, seed: int, speed_m_s: float, joint_spee
         hold = False
         if replan:
             rest = _remaining(path, q, index)
-            valid = all(edge_free(a.links, a.base, a.link_radius, obs_now, rest[i], rest[i + 1],
-                                  CERT_MARGIN_M) for i in range(rest.shape[0] - 1))
+            now = a.problem(CERT_MARGIN_M)._replace(obstacles=obs_now)
+            valid = all(edge_free(now, rest[i], rest[i + 1], CERT_MARGIN_M)
+                        for i in range(rest.shape[0] - 1))
             if not valid:
                 row["replans"] += 1
                 t0 = time.perf_counter()
@@ -131,8 +132,8 @@ def execute_once(scenario, planner: str, seed: int, speed_m_s: float, joint_spee
             moved = np.vstack([moved, q[None, :]])
         t += dt
         obs_next = _moved(a.obstacles, velocity, t)
-        c = min_clearance_kernel(a.links, a.base, a.link_radius, obs_next, moved, 1e-6, 200_000,
-                                 True)[0]
+        c = min_clearance_kernel(a.problem(CERT_MARGIN_M)._replace(obstacles=obs_next), moved,
+                                 1e-6, 200_000, True)[0]
         if c <= 0.0:
             row["collided"] = True
             row["time_s"] = t

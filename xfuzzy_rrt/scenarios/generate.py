@@ -137,14 +137,14 @@ def _draw_mira(rng: np.random.Generator, name: str) -> Scenario:
 
 
 @nb.njit(cache=True, nogil=True)
-def _free_grid(links, base, radius, obstacles, angles, margin):
+def _free_grid(P, angles, margin):
     free = np.empty((angles.size, angles.size), dtype=np.bool_)
     q = np.empty(2)
     for i in range(angles.size):
         q[0] = angles[i]
         for j in range(angles.size):
             q[1] = angles[j]
-            free[i, j] = clearance_kernel(links, base, radius, obstacles, q) > margin
+            free[i, j] = clearance_kernel(P, q) > margin
     return free
 
 
@@ -152,7 +152,7 @@ def c_space_grid(scenario: Scenario, step_deg: float = GRID_DEG) -> tuple[np.nda
     """``(angles, free)``: grid angles and a boolean [n, n] map of free configurations."""
     a = scenario.arrays()
     angles = np.arange(-180.0, 180.0 + 1e-9, step_deg)
-    return angles, _free_grid(a.links, a.base, a.link_radius, a.obstacles, angles, CERT_MARGIN_M)
+    return angles, _free_grid(a.problem(CERT_MARGIN_M), angles, CERT_MARGIN_M)
 
 
 def grid_optimal_deg(scenario: Scenario, step_deg: float = GRID_DEG,
@@ -237,10 +237,9 @@ def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample")
         a = s.arrays()
         if segment_free(a, a.start_deg, a.goal_deg):
             continue  # trivial: the straight segment is free
-        if not (config_free(a.links, a.base, a.link_radius, a.obstacles, a.limits_deg,
-                            a.start_deg, CERT_MARGIN_M)
-                and config_free(a.links, a.base, a.link_radius, a.obstacles, a.limits_deg,
-                                a.goal_deg, CERT_MARGIN_M)):
+        problem = a.problem(CERT_MARGIN_M)
+        if not (config_free(problem, a.start_deg, CERT_MARGIN_M)
+                and config_free(problem, a.goal_deg, CERT_MARGIN_M)):
             continue  # free, but closer than the planners' margin
         if not plan_rrt(s, seed=0, max_iter=RRT_BUDGET).success:
             continue  # not shown solvable

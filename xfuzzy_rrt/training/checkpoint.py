@@ -22,7 +22,6 @@ from xfuzzy_rrt.atomic import atomic_path
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.strict import unknown_key_message
 from xfuzzy_rrt.training.ga import GAConfig, TrainState
-from xfuzzy_rrt.training.genome import N_GENES
 
 FORMAT = "xfuzzy-rrt-train-checkpoint"
 VERSION = 1
@@ -51,7 +50,7 @@ def save_checkpoint(directory: Path, state: TrainState, config: GAConfig) -> Pat
     arrays = {
         "meta": np.array(json.dumps(meta, sort_keys=True)),
         "population": state.population,
-        "hall_of_fame": np.array(state.hall_of_fame).reshape(-1, N_GENES),
+        "hall_of_fame": np.array(state.hall_of_fame).reshape(-1, config.n_genes),
     }
     if state.last_fitness is not None:
         arrays["last_fitness"] = state.last_fitness
@@ -102,9 +101,10 @@ def load_checkpoint(directory: Path, config: GAConfig) -> TrainState:
                          "seed or GA options differ); resume with the options it was made with")
     generation = meta.get("generation")
     history = meta.get("history")
+    size = config.n_genes  # the genome of the configuration's DOF (the fingerprint holds it)
     if (not isinstance(generation, int) or not isinstance(history, list)
-            or len(history) != generation or hof.shape != (generation, N_GENES)
-            or population.shape != (config.population, N_GENES)
+            or len(history) != generation or hof.shape != (generation, size)
+            or population.shape != (config.population, size)
             or not np.all(np.isfinite(population))):
         raise InputError(where, "corrupt checkpoint (inconsistent contents)")
     return TrainState(

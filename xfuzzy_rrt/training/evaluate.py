@@ -21,8 +21,6 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_OUTPUTS
-from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
 from xfuzzy_rrt.planners.fuzzy_rrt import (
     BOUNDS_ABSOLUTE,
     BOUNDS_RELATIVE,
@@ -31,85 +29,65 @@ from xfuzzy_rrt.planners.fuzzy_rrt import (
     fuzzy_rrt_kernel,
 )
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
-from xfuzzy_rrt.planners.tree import Tree
+from xfuzzy_rrt.planners.trace_record import make_trace
+from xfuzzy_rrt.planners.tree import make_tree, reset_tree
 
 FAILURE_REWARD = -100.0
 
 
 @nb.njit(cache=True, nogil=True)
-def run_population(links, base, radius, obstacles, limits, start, goal, knots_b, consts_b,
-                   bounds_mode, seeds, max_iter, min_step, margin,
-                   nodes, parent, cell_next, cell_head, meta, grid):
+def run_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_step, stop, TR):
     """Iterations of every (individual, seed) run: int64[P, R], ``-1`` for a failed run.
 
-    ``knots_b`` [P, 6, 4, 5] and ``consts_b`` [P, 6, 625] are decoded individuals; the tree
-    arrays are one preallocated :class:`~xfuzzy_rrt.planners.tree.Tree`, reset before each run.
+    ``knots_b`` [P, n_out, 4, 5] and ``consts_b`` [P, n_out, 625] are decoded individuals;
+    ``T`` is one preallocated tree (:func:`~xfuzzy_rrt.planners.tree.make_tree`), emptied
+    before each run; ``TR`` 1-row trace buffers the kernels never touch (``record`` is off).
     """
     n_ind = knots_b.shape[0]
     n_seeds = seeds.shape[0]
     out = np.empty((n_ind, n_seeds), dtype=np.int64)
-    meta0 = meta.copy()
-    # 1-row trace dummies: the kernel never touches them when record is False
-    tr_from = np.empty(1, dtype=np.int64)
-    tr_x = np.empty((1, 4))
-    tr_y = np.empty((1, N_OUTPUTS))
-    tr_box = np.empty((1, 4))
-    tr_gs = np.empty(1, dtype=np.bool_)
-    tr_sample = np.empty((1, 2))
-    tr_nearest = np.empty(1, dtype=np.int64)
-    tr_new = np.empty((1, 2))
-    tr_outcome = np.empty(1, dtype=np.int8)
-    tr_node = np.empty(1, dtype=np.int64)
-    tr_tree = np.empty(1, dtype=np.int64)
-    tr_rule = np.empty((1, N_OUTPUTS, MAX_FIRED), dtype=np.int32)
-    tr_w = np.empty((1, N_OUTPUTS, MAX_FIRED))
+    meta0 = T.meta.copy()
     for p in range(n_ind):
         for r in range(n_seeds):
-            meta[:] = meta0
-            cell_head[:] = -1
+            reset_tree(T, meta0)
             if bounds_mode == GOAL_FRAME:
                 ok, iterations, _ = goal_frame_kernel(
-                    links, base, radius, obstacles, limits, start, goal, seeds[r], max_iter,
-                    knots_b[p], consts_b[p], bounds_mode, min_step, margin,
-                    nodes, parent, cell_next, cell_head, meta, grid,
-                    False, tr_from, tr_x, tr_y, tr_box, tr_gs, tr_sample, tr_nearest, tr_new,
-                    tr_outcome, tr_node, tr_tree, tr_rule, tr_w)
+                    P, T, seeds[r], max_iter, knots_b[p], consts_b[p], bounds_mode, min_step,
+                    stop, False, TR)
             else:
                 ok, iterations, _ = fuzzy_rrt_kernel(
-                    links, base, radius, obstacles, limits, start, goal, seeds[r], max_iter,
-                    knots_b[p], consts_b[p], bounds_mode, min_step, margin,
-                    nodes, parent, cell_next, cell_head, meta, grid,
-                    False, tr_from, tr_x, tr_y, tr_box, tr_gs, tr_sample, tr_nearest, tr_new,
-                    tr_outcome, tr_node, tr_tree, tr_rule, tr_w)
+                    P, T, seeds[r], max_iter, knots_b[p], consts_b[p], bounds_mode, min_step,
+                    stop, False, TR)
             out[p, r] = iterations if ok else -1
     return out
 
 
 @dataclass(frozen=True)
 class Problem:
-    """One scenario as the arrays the kernel needs (picklable: sent once to each worker)."""
+    """One scenario as the compiled problem bundle the kernels take (picklable: sent once to
+    each worker). ``groups``: fuzzy evaluations per iteration under the paper's semantics (one
+    per arm)."""
 
     name: str
-    links: np.ndarray
-    base: np.ndarray
-    radius: float
-    obstacles: np.ndarray
-    limits: np.ndarray
-    start: np.ndarray
-    goal: np.ndarray
-    #: The kernels' margin: the scenario's clearance folded in (geometry/clearance.py).
-    margin: float = CERT_MARGIN_M
+    bundle: object
+    groups: int = 1
+
+    @property
+    def limits(self) -> np.ndarray:
+        return self.bundle.limits
+
+    @property
+    def dof(self) -> int:
+        return int(self.bundle.start.shape[0])
 
     @classmethod
     def from_scenario(cls, scenario) -> "Problem":
         from xfuzzy_rrt.geometry.clearance import planning_margin
-        from xfuzzy_rrt.planners.checks import check_planar_2dof
+        from xfuzzy_rrt.planners.checks import check_dof
 
-        check_planar_2dof(scenario)
-        a = scenario.arrays()
-        return cls(name=scenario.name, links=a.links, base=a.base, radius=float(a.link_radius),
-                   obstacles=a.obstacles, limits=a.limits_deg, start=a.start_deg, goal=a.goal_deg,
-                   margin=planning_margin(scenario))
+        check_dof(scenario)
+        return cls(name=scenario.name, bundle=scenario.arrays().problem(planning_margin(scenario)),
+                   groups=len(scenario.arms))
 
 
 def iterations_for(problems: list[Problem], knots_b: np.ndarray, consts_b: np.ndarray,
@@ -124,12 +102,13 @@ def iterations_for(problems: list[Problem], knots_b: np.ndarray, consts_b: np.nd
     consts_b = np.ascontiguousarray(consts_b, dtype=np.float64)
     seeds = np.ascontiguousarray(seeds, dtype=np.int64)
     out = np.empty((knots_b.shape[0], len(problems), seeds.shape[0]), dtype=np.int64)
+    stop = np.zeros(1, dtype=np.int64)
     for s, pr in enumerate(problems):
-        tree = Tree(int(max_iter) + 2, pr.limits)
-        out[:, s, :] = run_population(
-            pr.links, pr.base, pr.radius, pr.obstacles, pr.limits, pr.start, pr.goal,
-            knots_b, consts_b, mode, seeds, int(max_iter), MIN_STEP_DEG, pr.margin,
-            tree.nodes, tree.parent, tree.cell_next, tree.cell_head, tree.meta, tree.grid)
+        tree = make_tree(int(max_iter) + 2, pr.limits)
+        groups = 1 if mode == GOAL_FRAME else pr.groups
+        buffers = make_trace(1, pr.dof, knots_b.shape[1], groups)
+        out[:, s, :] = run_population(pr.bundle, tree, knots_b, consts_b, mode, seeds,
+                                      int(max_iter), MIN_STEP_DEG, stop, buffers)
     return out
 
 
@@ -185,16 +164,14 @@ def rrt_baseline(problems: list[Problem], seeds: np.ndarray, max_iter: int) -> n
 
     out = np.empty(len(problems))
     for s, pr in enumerate(problems):
-        tree = Tree(int(max_iter) + 2, pr.limits)
+        tree = make_tree(int(max_iter) + 2, pr.limits)
         meta0 = tree.meta.copy()
+        stop = np.zeros(1, dtype=np.int64)
         its = []
         for seed in seeds:
-            tree.meta[:] = meta0
-            tree.cell_head[:] = -1
-            ok, x, _ = rrt_kernel(pr.links, pr.base, pr.radius, pr.obstacles, pr.limits,
-                                  pr.start, pr.goal, int(seed), int(max_iter), DEFAULT_STEP_DEG,
-                                  DEFAULT_GOAL_BIAS, pr.margin, tree.nodes, tree.parent,
-                                  tree.cell_next, tree.cell_head, tree.meta, tree.grid)
+            reset_tree(tree, meta0)
+            ok, x, _ = rrt_kernel(pr.bundle, tree, int(seed), int(max_iter), DEFAULT_STEP_DEG,
+                                  DEFAULT_GOAL_BIAS, stop)
             its.append(x if ok else max_iter)
         out[s] = float(np.median(its))
     return out

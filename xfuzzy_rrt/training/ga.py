@@ -43,16 +43,17 @@ from typing import Callable
 
 import numpy as np
 
-from xfuzzy_rrt.fuzzy.variables import N_OUTPUTS, N_RULES
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.fuzzy.variables import N_RULES
 from xfuzzy_rrt.training.evaluate import FITNESSES, score
 from xfuzzy_rrt.training.genome import (
     GENES_PER_FIS,
     MF_GENES,
     MODES,
-    N_GENES,
     constant_genome,
     constant_outputs_genome,
     encode,
+    n_genes,
 )
 
 HISTORY_COLUMNS = ["generation", "best_fitness", "mean_fitness", "median_fitness", "wall_s",
@@ -93,6 +94,14 @@ class GAConfig:
     #: (name, sha256) of each seed rulebook of a seeded first generation, in order: the first
     #: generation depends on them, so they are part of the fingerprint and of the provenance.
     seed_rulebooks: tuple[tuple[str, str], ...] = ()
+    #: ``--dof``: joints of the rulebook trained (paper: per arm; goal-frame: of all arms
+    #: together). It sizes the genome (:func:`~.genome.n_genes`).
+    dof: int = _sem.DEFAULT_DOF
+
+    @property
+    def n_genes(self) -> int:
+        """Genes of one individual at this configuration's bounds mode and DOF."""
+        return n_genes(self.bounds, self.dof)
 
     def __post_init__(self) -> None:
         from xfuzzy_rrt.errors import InputError
@@ -124,6 +133,8 @@ class GAConfig:
         need(len(self.scenarios) >= 1, "--scenario", "give at least one training scenario")
         need(self.init == "seeded" or not self.seed_rulebooks, "--seed-rulebook",
              "seed rulebooks are only used with --init seeded")
+        problem = _sem.dof_problem(self.dof)
+        need(problem is None, "--dof", problem or "")
 
     #: Options that only say when to stop or how to choose at the end: a checkpoint may be
     #: resumed with other values (e.g. more generations), and the result is then exactly that
@@ -132,7 +143,7 @@ class GAConfig:
     #: Options added after the first checkpoints were written: left out of the fingerprint
     #: while they keep their default, so older checkpoints still resume.
     LATER = {"fitness": "paper", "baseline": (), "validation": (), "validation_baseline": (),
-             "seed_rulebooks": (), "clearance_m": None}
+             "seed_rulebooks": (), "clearance_m": None, "dof": _sem.DEFAULT_DOF}
 
     def fingerprint(self) -> str:
         """SHA-256 of the options that shape the search (identifies a checkpoint's run),
@@ -174,36 +185,42 @@ GOAL_FRAME_SEEDS = (
 )
 
 
-def seed_genomes(bounds: str, rulebooks=()) -> list[tuple[str, np.ndarray]]:
+def seed_genomes(bounds: str, rulebooks=(), dof: int = _sem.DEFAULT_DOF) -> list[tuple[str, np.ndarray]]:
     """Named genomes that already solve problems (see the module docstring): the built-in
     constant ones, then each of ``rulebooks`` (which must mean what the training means:
-    the same bounds, or the goal-frame semantics)."""
+    the same bounds, or the goal-frame semantics, and the same DOF). At N joints the paper's
+    built-in boxes give every joint the same interval (the 2-DOF ones repeated)."""
+    for rb in rulebooks:
+        if rb.dof != dof:
+            raise ValueError(f"seed rulebook {rb.name!r} is for dof {rb.dof}, the training "
+                             f"for dof {dof}")
     if bounds == "goal-frame":
-        out = [(f"goal-frame-{i}", constant_outputs_genome(v, bounds))
+        out = [(f"goal-frame-{i}", constant_outputs_genome(v, bounds, dof))
                for i, v in enumerate(GOAL_FRAME_SEEDS)]
         for rb in rulebooks:
             if rb.semantics.name != "goal-frame":
                 raise ValueError(f"seed rulebook {rb.name!r} is not a goal-frame rulebook")
-            out.append((rb.name, encode(*rb.arrays(), bounds)))
+            out.append((rb.name, encode(*rb.arrays(), bounds, dof)))
         return out
-    full = (-180.0, 180.0, -180.0, 180.0)
+    full = (-180.0, 180.0) * dof
     out = [("rrt-equivalent", constant_genome(0.05, full, 10.0))]
     for bias in (0.1, 0.2, 0.35, 0.5):
         out.append((f"rrt-bias-{bias}", constant_genome(bias, full, 10.0)))
     if bounds == "relative":
         for half in (30.0, 60.0, 90.0):
-            out.append((f"window-{half:g}", constant_genome(0.2, (-half, half, -half, half), 10.0)))
+            out.append((f"window-{half:g}", constant_genome(0.2, (-half, half) * dof, 10.0)))
     for rb in rulebooks:
         if rb.semantics.name != "paper" or rb.bounds_mode != bounds:
             raise ValueError(f"seed rulebook {rb.name!r} has {rb.bounds_mode} bounds, the "
                              f"training {bounds}")
         knots, consts = rb.arrays()
-        out.append((rb.name, encode(knots, consts)))
+        out.append((rb.name, encode(knots, consts, "absolute", dof)))
     return out
 
 
 def initial_population(config: GAConfig, rng: np.random.Generator, rulebooks=()) -> np.ndarray:
-    """The first generation ``[population, 3822]`` (deterministic given ``rng``).
+    """The first generation ``[population, n_genes]`` (deterministic given ``rng``; 3,822 genes
+    at 2 DOF).
 
     ``rulebooks`` are the seed rulebooks; they must be exactly those ``config.seed_rulebooks``
     names (same order, same SHA-256), so the population depends only on what is recorded.
@@ -213,20 +230,22 @@ def initial_population(config: GAConfig, rng: np.random.Generator, rulebooks=())
     if given != tuple(tuple(x) for x in config.seed_rulebooks):
         raise ValueError(f"seed rulebooks {given} are not the configuration's "
                          f"{config.seed_rulebooks}")
+    size = config.n_genes
+    n_fis = size // GENES_PER_FIS
     if config.init == "random":
-        return rng.random((n, N_GENES))
-    seeds = [g for _, g in seed_genomes(config.bounds, rulebooks)]
-    pop = np.empty((n, N_GENES))
+        return rng.random((n, size))
+    seeds = [g for _, g in seed_genomes(config.bounds, rulebooks, config.dof)]
+    pop = np.empty((n, size))
     k = min(len(seeds), n)
     pop[:k] = np.array(seeds[:k])
     scales = (0.02, 0.05, 0.1, 0.2)
     for i in range(k, n):
         base = seeds[int(rng.integers(len(seeds)))]
         sigma = scales[int(rng.integers(len(scales)))]
-        g = base + 0.25 * sigma * rng.standard_normal(N_GENES)
-        g = g.reshape(N_OUTPUTS, GENES_PER_FIS)
-        g[:, MF_GENES:] += term_blocks(rng, sigma, N_OUTPUTS)
-        pop[i] = np.clip(g.reshape(N_GENES), 0.0, 1.0)
+        g = base + 0.25 * sigma * rng.standard_normal(size)
+        g = g.reshape(n_fis, GENES_PER_FIS)
+        g[:, MF_GENES:] += term_blocks(rng, sigma, n_fis)
+        pop[i] = np.clip(g.reshape(size), 0.0, 1.0)
     return pop
 
 
@@ -301,9 +320,10 @@ def breed(pop: np.ndarray, fit: np.ndarray, config: GAConfig, rng: np.random.Gen
     if config.block_rate > 0:
         # term-block mutation (see term_blocks): one random FIS per chosen child
         hit = np.flatnonzero(rng.random(n_children) < config.block_rate)
-        fis = rng.integers(N_OUTPUTS, size=hit.size)
+        n_fis = n_var // GENES_PER_FIS  # the genome's own FIS count (6 at 2 DOF)
+        fis = rng.integers(n_fis, size=hit.size)
         blocks = term_blocks(rng, config.block_sigma, hit.size)
-        view = children.reshape(n_children, N_OUTPUTS, GENES_PER_FIS)
+        view = children.reshape(n_children, n_fis, GENES_PER_FIS)
         view[hit, fis, MF_GENES:] += blocks
     return np.vstack([elites, np.clip(children, 0.0, 1.0)])
 

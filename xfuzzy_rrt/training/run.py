@@ -6,7 +6,7 @@ Output layout of ``--out DIR``::
     DIR/history.csv                       one row per generation (rewritten atomically each one)
     DIR/checkpoint/state.npz              the latest checkpoint (see .checkpoint)
 
-Everything in the rulebook — the six systems *and* the manifest — depends only on the training
+Everything in the rulebook — the fuzzy systems (six at 2 DOF) *and* the manifest — depends only on the training
 inputs (scenario files, seed rulebooks, options, ``--seed``), never on the worker count, the
 engine or an interruption: the manifest records a canonical command line rebuilt from the
 options (not the literal argv, which would differ with ``--workers`` or ``--resume``), the
@@ -65,14 +65,67 @@ def expand_scenarios(paths: list[Path]) -> list[Path]:
     return out
 
 
+def scenario_dof(scenario, bounds: str) -> int:
+    """The rulebook DOF a training *scenario* asks for under *bounds*.
+
+    The paper's semantics decides one arm's box (two bounds per joint), so its DOF is the
+    per-arm DOF, and every arm of the scenario must have it. The goal-frame semantics works in
+    the joint space of all arms together, so its DOF is the total (``scenario.dof``).
+    """
+    where = scenario.source or scenario.name
+    if bounds == "goal-frame":
+        return int(scenario.dof)
+    dofs = [int(a.dof) for a in scenario.arms]
+    if len(set(dofs)) != 1:
+        raise InputError(str(where), f"arms: a paper-semantics rulebook gives every arm the same "
+                         f"box, but the arms have {', '.join(map(str, dofs))} joints (use "
+                         f"--bounds goal-frame, or arms of one DOF)")
+    return dofs[0]
+
+
+def training_dof(scenarios, bounds: str, dof: int | None = None) -> int:
+    """The DOF to train: that of the scenarios (which must agree), or ``--dof`` (which must
+    agree with them). *scenarios* are :class:`TrainingScenario` or scenario objects.
+
+    Raises :class:`InputError` (one line) for scenarios of different DOF or a ``--dof`` that
+    disagrees with them, naming a file of each DOF.
+    """
+    from xfuzzy_rrt.fuzzy import semantics as _sem
+
+    if dof is not None:
+        problem = _sem.dof_problem(dof)
+        if problem:
+            raise InputError("--dof", problem)
+    found: dict[int, str] = {}
+    for t in scenarios:
+        s = getattr(t, "scenario", t)
+        d = scenario_dof(s, bounds)
+        found.setdefault(d, str(getattr(t, "path", None) or s.source or s.name))
+    what = "joints in all" if bounds == "goal-frame" else "joints per arm"
+    if len(found) > 1:
+        listed = "; ".join(f"{f} has {d}" for d, f in sorted(found.items()))
+        raise InputError("--scenario", f"training scenarios of different DOF ({what}): {listed}; "
+                         "train one DOF at a time")
+    if not found:
+        return dof if dof is not None else _sem.DEFAULT_DOF
+    (have, file), = found.items()
+    if dof is not None and dof != have:
+        raise InputError("--dof", f"{dof} disagrees with the training scenarios ({file} has "
+                         f"{have} {what})")
+    problem = _sem.dof_problem(have)
+    if problem:
+        raise InputError(file, f"no rulebook for this arm: {problem}")
+    return have
+
+
 def load_training_scenarios(paths: list[Path]) -> list[TrainingScenario]:
     from xfuzzy_rrt.geometry.scenario import load_scenario
-    from xfuzzy_rrt.planners.checks import check_planar_2dof
+    from xfuzzy_rrt.planners.checks import check_dof
 
     items = []
     for p in expand_scenarios(paths):
         s = load_scenario(p)
-        check_planar_2dof(s)
+        check_dof(s)
         items.append(TrainingScenario(path=str(p), sha256=hashlib.sha256(p.read_bytes()).hexdigest(),
                                       scenario=s))
     names = [t.scenario.name for t in items]
@@ -94,7 +147,13 @@ class SeedRulebook:
         return self.rulebook.sha256
 
 
-def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str) -> list[SeedRulebook]:
+def default_seed_rulebook(dof: int = 2) -> str:
+    """Name of the shipped seed rulebook at *dof* joints: ``expert``, or ``expert-5dof``."""
+    return DEFAULT_SEED_RULEBOOK if dof == 2 else f"{DEFAULT_SEED_RULEBOOK}-{dof}dof"
+
+
+def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str,
+                           dof: int = 2) -> list[SeedRulebook]:
     """The seed rulebooks of a training run, loaded and checked.
 
     ``paths`` are the ``--seed-rulebook`` values (``None``: not given). Under ``--init
@@ -102,7 +161,9 @@ def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str) -> 
     ``bounds`` (none otherwise: the paper's absolute setting starts from the built-in genomes
     alone); a missing default or a given seed that does not exist, does not load or has the
     other bounds meaning is an error, never silently dropped (the first generation would
-    change under the same recorded command).
+    change under the same recorded command). At another DOF the default is the shipped
+    ``expert-<N>dof`` when there is one (:func:`default_seed_rulebook`), else none: the
+    built-in genomes alone, which exist at every DOF. A given seed of another DOF is an error.
     """
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
 
@@ -111,15 +172,20 @@ def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str) -> 
             raise InputError("--seed-rulebook", "seed rulebooks are only used with --init seeded")
         return []
     if not paths:
-        folder = rulebooks_dir() / DEFAULT_SEED_RULEBOOK
+        folder = rulebooks_dir() / default_seed_rulebook(dof)
         if not folder.is_dir():
+            if dof != 2:
+                return []
             raise InputError(str(folder), f"the default seed rulebook {DEFAULT_SEED_RULEBOOK!r} "
                              "is missing; pass --seed-rulebook DIR or --init random")
         rb = load_rulebook(folder)
-        return [SeedRulebook(PACKAGED, rb)] if rb.bounds_mode == bounds else []
+        return [SeedRulebook(PACKAGED, rb)] if rb.bounds_mode == bounds and rb.dof == dof else []
     out = []
     for p in paths:
         rb = load_rulebook(p)  # a missing or broken folder is the usual one-line error
+        if rb.dof != dof:
+            raise InputError(str(p), f"seed rulebook is for dof {rb.dof}, the training for dof "
+                             f"{dof}")
         if bounds == "goal-frame":
             if rb.semantics.name != "goal-frame":
                 raise InputError(str(p), "seed rulebook is not a goal-frame rulebook, but "
@@ -168,7 +234,7 @@ def canonical_command(config: GAConfig, scenario_args: list[str], out: str,
                ("mutation_rate", "--mutation-rate"), ("mutation_eta", "--mutation-eta"),
                ("block_rate", "--block-rate"), ("block_sigma", "--block-sigma"),
                ("init", "--init"), ("validation_runs", "--validation-runs"),
-               ("fitness", "--fitness"), ("clearance_m", "--clearance")]
+               ("fitness", "--fitness"), ("clearance_m", "--clearance"), ("dof", "--dof")]
     always = {"population", "generations", "runs_per_eval", "target_fitness", "seed", "bounds"}
     for attr, flag in options:
         value = getattr(config, attr)
@@ -272,12 +338,13 @@ def run_training(job: TrainJob,
     # the engines first: a bad --scheduler or --workers fails before any folder is made
     with contextlib.ExitStack() as stack:
         evaluator = stack.enter_context(make_evaluator(problems, config.bounds, config.max_iter,
-                                                       job.workers, job.scheduler))
+                                                       job.workers, job.scheduler,
+                                                       dof=config.dof))
         validator = None
         if held_out:
             validator = stack.enter_context(make_evaluator(held_out, config.bounds,
                                                            config.max_iter, job.workers,
-                                                           job.scheduler))
+                                                           job.scheduler, dof=config.dof))
         job.out.mkdir(parents=True, exist_ok=True)
         _remove_stale_temporaries(job)
         if on_start:
@@ -314,10 +381,10 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
     c = job.config
     from xfuzzy_rrt.training.genome import semantics_of_mode
 
-    knots, consts = decode(result.genes, c.bounds)
+    knots, consts = decode(result.genes, c.bounds, c.dof)
     history = result.state.history
     name = job.name or job.out.name or "trained"
-    sem = semantics_of_mode(c.bounds)
+    sem = semantics_of_mode(c.bounds, c.dof)
     provenance = {
         "kind": "ga",
         "command": canonical_command(c, job.scenario_args or [t.path for t in job.scenarios],
@@ -344,6 +411,7 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
         "history": HISTORY_FILE,
         "fitness": c.fitness,
         **({"clearance_m": c.clearance_m} if c.clearance_m is not None else {}),
+        **({"dof": c.dof} if c.dof != 2 else {}),  # 2-DOF manifests keep their bytes
         "scenarios": [{"name": t.scenario.name, "file": t.path, "sha256": t.sha256}
                       for t in job.scenarios],
         "seed_rulebooks": [{"name": s.rulebook.name, "source": s.source, "sha256": s.sha256}
@@ -371,5 +439,5 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
 
 
 __all__ = ["SeedRulebook", "TrainJob", "TrainingScenario", "canonical_command",
-           "expand_scenarios", "history_frame", "library_versions", "load_training_scenarios",
+           "default_seed_rulebook", "expand_scenarios", "scenario_dof", "training_dof", "history_frame", "library_versions", "load_training_scenarios",
            "resolve_seed_rulebooks", "run_training"]

@@ -38,9 +38,10 @@ PR_SET_PDEATHSIG = 1
 
 
 def evaluate_chunk(genes: np.ndarray, problems: Sequence[Problem], bounds_mode: str,
-                   seeds: np.ndarray, max_iter: int) -> np.ndarray:
-    """Iterations int64[n, S, R] of the individuals ``genes`` [n, 3822]."""
-    knots, consts = decode(genes, bounds_mode)
+                   seeds: np.ndarray, max_iter: int, dof: int = 2) -> np.ndarray:
+    """Iterations int64[n, S, R] of the individuals ``genes`` [n, n_genes] (3,822 at 2 DOF;
+    *dof* fixes the genome's outputs and ranges, see :func:`~.genome.decode`)."""
+    knots, consts = decode(genes, bounds_mode, dof)
     return iterations_for(list(problems), knots, consts, bounds_mode, seeds, max_iter)
 
 
@@ -76,8 +77,8 @@ def _init_worker(problems: list[Problem], parent_pid: int) -> None:
                    "absolute", np.zeros(1, dtype=np.int64), 5)
 
 
-def _evaluate_in_worker(genes, bounds_mode, seeds, max_iter):
-    return evaluate_chunk(genes, _PROBLEMS, bounds_mode, seeds, max_iter)
+def _evaluate_in_worker(genes, bounds_mode, seeds, max_iter, dof=2):
+    return evaluate_chunk(genes, _PROBLEMS, bounds_mode, seeds, max_iter, dof)
 
 
 def _chunks(n: int, parts: int) -> list[slice]:
@@ -93,10 +94,11 @@ class Evaluator:
     finish (for the CLI's progress display). Use as a context manager to release workers.
     """
 
-    def __init__(self, problems: list[Problem], bounds_mode: str, max_iter: int):
+    def __init__(self, problems: list[Problem], bounds_mode: str, max_iter: int, dof: int = 2):
         self.problems = list(problems)
         self.bounds_mode = bounds_mode
         self.max_iter = int(max_iter)
+        self.dof = int(dof)  # the rulebook DOF the genomes encode
 
     description = "in-process"
 
@@ -106,7 +108,7 @@ class Evaluator:
         parts = _chunks(genes.shape[0], CHUNKS_PER_WORKER)
         for k, sl in enumerate(parts):
             out[sl] = evaluate_chunk(genes[sl], self.problems, self.bounds_mode, seeds,
-                                     self.max_iter)
+                                     self.max_iter, self.dof)
             if progress:
                 progress(k + 1, len(parts))
         return out
@@ -124,8 +126,8 @@ class Evaluator:
 class ProcessEvaluator(Evaluator):
     """Local worker processes (the default: one per core)."""
 
-    def __init__(self, problems, bounds_mode, max_iter, workers: int):
-        super().__init__(problems, bounds_mode, max_iter)
+    def __init__(self, problems, bounds_mode, max_iter, workers: int, dof: int = 2):
+        super().__init__(problems, bounds_mode, max_iter, dof)
         self.workers = int(workers)
         self.description = f"{self.workers} local worker processes"
         self._pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_init_worker,
@@ -135,7 +137,7 @@ class ProcessEvaluator(Evaluator):
         out = np.empty((genes.shape[0], len(self.problems), len(seeds)), dtype=np.int64)
         parts = _chunks(genes.shape[0], CHUNKS_PER_WORKER * self.workers)
         futures = {self._pool.submit(_evaluate_in_worker, genes[sl], self.bounds_mode, seeds,
-                                     self.max_iter): sl for sl in parts}
+                                     self.max_iter, self.dof): sl for sl in parts}
         for k, fut in enumerate(as_completed(futures), start=1):
             out[futures[fut]] = fut.result()
             if progress:
@@ -177,8 +179,8 @@ def check_scheduler_address(address: str) -> None:
 class DaskEvaluator(Evaluator):
     """Tasks on a Dask distributed cluster (``--scheduler ADDRESS``)."""
 
-    def __init__(self, problems, bounds_mode, max_iter, address: str):
-        super().__init__(problems, bounds_mode, max_iter)
+    def __init__(self, problems, bounds_mode, max_iter, address: str, dof: int = 2):
+        super().__init__(problems, bounds_mode, max_iter, dof)
         check_scheduler_address(address)
         from distributed import Client
 
@@ -200,7 +202,7 @@ class DaskEvaluator(Evaluator):
         futures = []
         for sl in parts:
             fut = self._client.submit(evaluate_chunk, genes[sl], self._problems, self.bounds_mode,
-                                      seeds, self.max_iter, pure=False)
+                                      seeds, self.max_iter, self.dof, pure=False)
             futures.append((fut, sl))
         where = {f.key: sl for f, sl in futures}
         for k, fut in enumerate(as_completed([f for f, _ in futures], loop=self._client.loop), start=1):
@@ -214,15 +216,16 @@ class DaskEvaluator(Evaluator):
 
 
 def make_evaluator(problems: list[Problem], bounds_mode: str, max_iter: int,
-                   workers: int | None = None, scheduler: str | None = None) -> Evaluator:
+                   workers: int | None = None, scheduler: str | None = None,
+                   dof: int = 2) -> Evaluator:
     """The engine the options ask for: Dask with ``scheduler``, else ``workers`` processes
-    (default: all cores; 1 means in-process)."""
+    (default: all cores; 1 means in-process). *dof*: the rulebook DOF being trained."""
     if scheduler:
-        return DaskEvaluator(problems, bounds_mode, max_iter, scheduler)
+        return DaskEvaluator(problems, bounds_mode, max_iter, scheduler, dof)
     if workers is None:
         workers = os.cpu_count() or 1
     if workers < 1:
         raise InputError("--workers", f"must be >= 1, got {workers}")
     if workers == 1:
-        return Evaluator(problems, bounds_mode, max_iter)
-    return ProcessEvaluator(problems, bounds_mode, max_iter, workers)
+        return Evaluator(problems, bounds_mode, max_iter, dof)
+    return ProcessEvaluator(problems, bounds_mode, max_iter, workers, dof)

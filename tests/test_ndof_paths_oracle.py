@@ -65,8 +65,9 @@ PROBLEMS = [single_arm(n, v) for n in (3, 5, 7) for v in range(2)] + \
 
 def planners_for(s: Scenario) -> list[str]:
     """RRT always; Fuzzy-RRT with each shipped rulebook of matching DOF (paper-semantics
-    rulebooks are per arm: ``expert`` for 2-link arms, ``expert-5dof`` for 5-link arms; the
-    goal-frame rulebook is for 2 joints in all); OMPL RRTConnect when installed."""
+    rulebooks are per arm: ``expert`` for 2-link arms, ``expert-5dof`` for 5-link arms;
+    goal-frame rulebooks read all joints at once: ``goal-frame-5dof`` for one 5-link arm,
+    ``goal-frame-dual3`` for two 3-link arms); OMPL RRTConnect when installed."""
     per_arm = {a.dof for a in s.arms}
     out = ["rrt"]
     if per_arm == {2}:
@@ -75,6 +76,10 @@ def planners_for(s: Scenario) -> list[str]:
         out.append("fuzzy-rrt:expert-5dof")
     if s.dof == 2:
         out.append("fuzzy-rrt:goal-frame")
+    if len(s.arms) == 1 and s.dof == 5:
+        out.append("fuzzy-rrt:goal-frame-5dof")
+    if len(s.arms) == 2 and per_arm == {3}:
+        out.append("fuzzy-rrt:goal-frame-dual3")
     try:
         import ompl  # noqa: F401
         out.append("ompl:RRTConnect")

@@ -508,10 +508,13 @@ def segment_free(arrays, qa_deg, qb_deg, margin: float = CERT_MARGIN_M) -> bool:
     return bool(edge_free(arrays.problem(margin), qa, qb, float(margin)))
 
 
-def end_effector_obstacle(arrays, q_deg) -> tuple[float, float]:
-    """``(distance, angle)`` from the end effector to the nearest obstacle surface."""
-    from xfuzzy_rrt.geometry.kinematics import end_effector
+def end_effector_obstacle(arrays, q_deg, arm: int = 0) -> tuple[float, float]:
+    """``(distance, angle)`` from arm ``arm``'s end effector to the nearest obstacle surface
+    (other arms' capsules included): the paper's fuzzy inputs for that arm."""
+    from xfuzzy_rrt.geometry.kinematics import arm_end_effector
 
-    ex, ey = end_effector(arrays.links, arrays.base, np.asarray(q_deg, dtype=np.float64))
-    d, a, _ = nearest_obstacle_from_point(ex, ey, arrays.obstacles)
+    problem = arrays.problem(CERT_MARGIN_M)
+    q = np.asarray(q_deg, dtype=np.float64)
+    ex, ey = arm_end_effector(problem, arm, q)
+    d, a, _ = nearest_obstacle_for_arm(problem, arm, q, ex, ey)
     return float(d), float(a)

@@ -325,3 +325,9 @@ def test_explain_says_what_goal_frame_inputs_measure(tmp_path, run_cli):
         assert head[0].endswith("(goal-frame semantics)")
         assert head[2].startswith("Inputs (measured at the current node, in joint space")
         assert "sampling region" in proc.stdout and "end effector" not in proc.stdout
+
+
+def test_evaluate_without_a_rulebook_evaluates_the_shipped_default(run_cli, tmp_path):
+    proc = run_cli("evaluate", SCENARIOS[0], "--runs", "1", "--out", tmp_path / "ev")
+    assert proc.returncode == 0, proc.stderr
+    assert "fuzzy-rrt:goal-frame " in proc.stdout and "general" not in proc.stdout

@@ -30,7 +30,7 @@ def _fmt(v: float, unit: str = "") -> str:
 
 def evaluate(
     problems: List[Path] = typer.Argument(..., help="Scenario files or folders (a folder: every *.toml in it). Use problems no training or tuning saw."),
-    rulebook: List[str] = typer.Option(["general"], "--rulebook", help="Rulebook name or directory to evaluate (repeatable)."),
+    rulebook: List[str] = typer.Option([], "--rulebook", help="Rulebook name or directory to evaluate (repeatable; default: the shipped default rulebook)."),
     peer: List[str] = typer.Option([], "--peer", help="Also run this planner, e.g. ompl:RRTConnect (repeatable; ranked on time)."),
     runs: int = typer.Option(50, "--runs", help="Seeds per problem (seed .. seed + runs - 1, the same for every planner)."),
     seed: int = typer.Option(0, "--seed", help="First seed."),
@@ -56,6 +56,10 @@ def evaluate(
         check_clearance(clearance)
     if out is not None and out.exists() and not out.is_dir():
         raise InputError(str(out), "exists and is not a directory")
+    if not rulebook:
+        from xfuzzy_rrt.fuzzy.rulebook import DEFAULT_RULEBOOK
+
+        rulebook = [DEFAULT_RULEBOOK]
     entries = []
     for spec in rulebook:
         rb = _rulebook(spec)

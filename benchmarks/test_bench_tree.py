@@ -11,7 +11,7 @@ import numba as nb
 import numpy as np
 import pytest
 
-from xfuzzy_rrt.planners.tree import Tree, add_node, nearest, nearest_brute
+from xfuzzy_rrt.planners.tree import make_tree, add_node, nearest, nearest_brute
 
 N = 10_000
 
@@ -39,7 +39,7 @@ def tree_and_queries(request):
     rng = np.random.default_rng(0)
     steps = rng.normal(0, 6.0, size=(N, dof))
     walk = np.clip(np.cumsum(steps, axis=0) % 360.0 - 180.0, -180, 180)
-    tree = Tree(N, np.tile([-180.0, 180.0], (dof, 1)))
+    tree = make_tree(N, np.tile([-180.0, 180.0], (dof, 1)))
     for p in walk:
         add_node(tree, np.ascontiguousarray(p), -1)
     return tree, rng.uniform(-180, 180, size=(N, dof))

@@ -15,7 +15,7 @@ from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.result import path_cost_deg
 from xfuzzy_rrt.planners.rng import new_state, reference_stream, uniform
 from xfuzzy_rrt.planners.rrt import plan_rrt
-from xfuzzy_rrt.planners.tree import Tree, add_node, nearest, nearest_brute
+from xfuzzy_rrt.planners.tree import make_tree, add_node, nearest, nearest_brute
 
 SCENARIOS = sorted((FIXTURES / "scenarios").glob("*.toml")) + shared_scenarios()
 
@@ -82,7 +82,7 @@ def test_nearest_neighbour_equals_brute_force_in_any_dimension(seed, n, clustere
     lowest index included (rounded clustered points make many exact ties)."""
     rng = np.random.default_rng(seed)
     limits = np.tile([-180.0, 180.0], (dof, 1))
-    tree = Tree(n, limits)
+    tree = make_tree(n, limits)
     if clustered:
         pts = rng.normal(rng.uniform(-150, 150, dof), 8.0, size=(n, dof)).clip(-180, 180)
         pts = np.round(pts)  # many exact ties

@@ -310,7 +310,7 @@ from xfuzzy_rrt.planners.result import (  # noqa: E402
     path_cost_deg,
 )
 from xfuzzy_rrt.geometry.problem import single_arm_problem  # noqa: E402
-from xfuzzy_rrt.planners.tree import Tree, add_node, extract_path  # noqa: E402
+from xfuzzy_rrt.planners.tree import make_tree, add_node, extract_path  # noqa: E402
 
 ARM2 = np.array([0.2, 0.1])
 LIMITS2 = np.array([[-170.0, 170.0], [-150.0, 150.0]])
@@ -323,7 +323,7 @@ class _Ext:
         self.obstacles = np.zeros((0, 5)) if obstacles is None else np.asarray(obstacles, float)
         self.radius = radius
         self.goal = np.asarray(goal, dtype=float)
-        self.tree = Tree(capacity, LIMITS2)
+        self.tree = make_tree(capacity, LIMITS2)
         t = self.tree
         add_node(t, np.array([float(root[0]), float(root[1])]), -1)
         self.q_near = np.empty(2)
@@ -466,7 +466,7 @@ def test_every_edge_extend_adds_is_collision_free_and_at_most_one_step_long(
 
 
 def _chain_tree(points, parents):
-    t = Tree(len(points) + 1, LIMITS2)
+    t = make_tree(len(points) + 1, LIMITS2)
     for (x, y), p in zip(points, parents):
         add_node(t, np.array([float(x), float(y)]), p)
     return t

@@ -54,7 +54,8 @@ _TWO_PI = 2.0 * math.pi
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _point_segment_dist(px, py, ax, ay, bx, by):
+def _segment_offset(px, py, ax, ay, bx, by):
+    """Vector from point P to the nearest point of segment AB."""
     dx = bx - ax
     dy = by - ay
     den = dx * dx + dy * dy
@@ -65,8 +66,12 @@ def _point_segment_dist(px, py, ax, ay, bx, by):
             t = 0.0
         elif t > 1.0:
             t = 1.0
-    qx = ax + t * dx - px
-    qy = ay + t * dy - py
+    return ax + t * dx - px, ay + t * dy - py
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _point_segment_dist(px, py, ax, ay, bx, by):
+    qx, qy = _segment_offset(px, py, ax, ay, bx, by)
     return math.sqrt(qx * qx + qy * qy)
 
 
@@ -417,15 +422,7 @@ def nearest_obstacle_for_arm(P, arm, q_deg, px, py):
         theta = 0.0
         for k in range(P.arm_first[b], P.arm_first[b + 1]):
             nx, ny, theta = fk_step(x, y, theta, P.links[k], q_deg[k])
-            dx = nx - x
-            dy = ny - y
-            den = dx * dx + dy * dy
-            t = 0.0
-            if den > 0.0:
-                t = ((px - x) * dx + (py - y) * dy) / den
-                t = min(max(t, 0.0), 1.0)
-            vx = x + t * dx - px
-            vy = y + t * dy - py
+            vx, vy = _segment_offset(px, py, x, y, nx, ny)
             d = math.sqrt(vx * vx + vy * vy) - P.radii[b]
             if d < 0.0:
                 d = 0.0

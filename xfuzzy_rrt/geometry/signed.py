@@ -19,30 +19,19 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.geometry.collision import (
+    _point_segment_dist,
     link_motion_bound,
+    link_segments_into,
     segment_obstacle_dist,
     segment_segment_dist,
 )
-from xfuzzy_rrt.geometry.kinematics import fk_step
 
 
 @nb.njit(cache=True, nogil=True)
 def signed_segment_obstacle_dist(ax, ay, bx, by, ob):
     """Exact signed distance from segment AB to obstacle row ``ob``; negative = depth inside."""
     if ob[0] == 0.0:  # circle: distance from the centre to the segment, minus the radius
-        dx = bx - ax
-        dy = by - ay
-        den = dx * dx + dy * dy
-        t = 0.0
-        if den > 0.0:
-            t = ((ob[1] - ax) * dx + (ob[2] - ay) * dy) / den
-            if t < 0.0:
-                t = 0.0
-            elif t > 1.0:
-                t = 1.0
-        qx = ax + t * dx - ob[1]
-        qy = ay + t * dy - ob[2]
-        return math.sqrt(qx * qx + qy * qy) - ob[3]
+        return _point_segment_dist(ob[1], ob[2], ax, ay, bx, by) - ob[3]
     d = segment_obstacle_dist(ax, ay, bx, by, ob)
     if d > 0.0:
         return d
@@ -134,28 +123,19 @@ def element_clearances(P, q_deg, out):
     n_arms = P.arm_first.shape[0] - 1
     obstacles = P.obstacles
     nl = P.links.shape[0]
-    seg = np.empty((nl if n_arms > 1 else 0, 4))
+    seg = np.empty((nl, 4))
+    link_segments_into(P, q_deg, seg)
     for a in range(n_arms):
-        x = P.bases[a, 0]
-        y = P.bases[a, 1]
-        theta = 0.0
         for k in range(P.arm_first[a], P.arm_first[a + 1]):
-            nx, ny, theta = fk_step(x, y, theta, P.links[k], q_deg[k])
             ck = np.inf
             for o in range(obstacles.shape[0]):
-                d = signed_segment_obstacle_dist(x, y, nx, ny, obstacles[o]) - P.radii[a]
+                d = signed_segment_obstacle_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
+                                                 obstacles[o]) - P.radii[a]
                 if d < ck:
                     ck = d
             out[k] = ck
             if ck < best:
                 best = ck
-            if n_arms > 1:
-                seg[k, 0] = x
-                seg[k, 1] = y
-                seg[k, 2] = nx
-                seg[k, 3] = ny
-            x = nx
-            y = ny
     e = nl
     for a in range(n_arms):
         for b in range(a + 1, n_arms):

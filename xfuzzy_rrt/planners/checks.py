@@ -5,22 +5,18 @@ from __future__ import annotations
 import math
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.geometry.scenario import Scenario
+from xfuzzy_rrt.geometry.scenario import MAX_LINKS_PER_ARM, Scenario
 from xfuzzy_rrt.planners.termination import MAX_ITER_LIMIT, check_max_iter  # noqa: F401
-
-#: Joint-space dimensions the planners handle (all arms together).
-MIN_DOF = 2
-MAX_DOF = 28
 
 
 def check_dof(scenario: Scenario) -> None:
     """Every arm has 2..7 joints and the problem's configurations have one angle per joint."""
     where = scenario.source or scenario.name
     for a, arm in enumerate(scenario.arms):
-        if not 2 <= arm.dof <= 7:
+        if not 2 <= arm.dof <= MAX_LINKS_PER_ARM:
             key = "arm.links" if len(scenario.arms) == 1 else f"arms[{a}].links"
-            raise InputError(where, f"{key}: the planners handle arms of 2 to 7 joints, this "
-                             f"arm has {arm.dof}")
+            raise InputError(where, f"{key}: the planners handle arms of 2 to {MAX_LINKS_PER_ARM} "
+                             f"joints, this arm has {arm.dof}")
     for which, q in (("start", scenario.start_deg), ("goal", scenario.goal_deg)):
         if len(q) != scenario.dof:
             raise InputError(where, f"{which}: {len(q)} angles for {scenario.dof} joints")

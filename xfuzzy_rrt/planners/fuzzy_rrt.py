@@ -64,7 +64,7 @@ from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
 from xfuzzy_rrt.planners.extend import extend
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
-from xfuzzy_rrt.planners.params import resolve_params
+from xfuzzy_rrt.planners.params import default, resolve_params
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
@@ -72,7 +72,7 @@ from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
-MIN_STEP_DEG = 0.5
+MIN_STEP_DEG = default("fuzzy-rrt", "min_step_deg")
 BOUNDS_ABSOLUTE = 0
 BOUNDS_RELATIVE = 1
 #: Kernel mode of a goal-frame rulebook (see :mod:`xfuzzy_rrt.planners.goal_frame`).

@@ -49,6 +49,11 @@ PARAMS: dict[str, tuple[Param, ...]] = {
 }
 
 
+def default(planner: str, name: str):
+    """The declared default of parameter ``name`` (the one place a default is written)."""
+    return next(p.default for p in PARAMS[planner] if p.name == name)
+
+
 def describe(planner: str) -> list[Param]:
     """The parameters of ``planner`` (``rrt`` or ``fuzzy-rrt``)."""
     try:

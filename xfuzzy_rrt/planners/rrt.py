@@ -20,15 +20,15 @@ from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
 from xfuzzy_rrt.planners.extend import extend
-from xfuzzy_rrt.planners.params import resolve_params
+from xfuzzy_rrt.planners.params import default, resolve_params
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
 
-DEFAULT_STEP_DEG = 10.0
-DEFAULT_GOAL_BIAS = 0.05
-DEFAULT_MAX_ITER = 10_000
+DEFAULT_STEP_DEG = default("rrt", "step_deg")
+DEFAULT_GOAL_BIAS = default("rrt", "goal_bias")
+DEFAULT_MAX_ITER = default("rrt", "max_iter")
 
 
 @nb.njit(cache=True, nogil=True)

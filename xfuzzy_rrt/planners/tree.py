@@ -48,7 +48,8 @@ class TreeArrays(NamedTuple):
     meta: np.ndarray
     grid: np.ndarray
     #: k-d tree (3+ joints): node indices in tree order (the subtree of range ``[lo, hi)`` has
-    #: its root at ``(lo + hi) // 2``), each position's split axis, and the search stack.
+    #: its root at ``(lo + hi) // 2``), each position's split axis, and the stack of ranges
+    #: ``(lo, hi, depth)`` with the query's lower bound per range.
     kd_perm: np.ndarray
     kd_axis: np.ndarray
     kd_stack: np.ndarray
@@ -76,11 +77,8 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
         np.array([0, ncx, ncy, ncx, ncy, -1, -1, 0], dtype=np.int64),
         np.array([limits_deg[0, 0], limits_deg[1, 0], cell_deg], dtype=np.float64),
         np.zeros(kd, dtype=np.int64), np.zeros(kd, dtype=np.int64),
-        np.zeros((KD_STACK, 2), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64))
+        np.zeros((KD_STACK, 3), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64))
 
-
-#: Old name, kept for callers that build a tree by hand.
-Tree = make_tree
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -218,32 +216,30 @@ def _kd_build(T, n):
     for i in range(n):
         T.kd_perm[i] = i
     stack = T.kd_stack
-    depth = T.kd_axis  # reused below: written as each range's root is placed
-    top = 0
     stack[0, 0] = 0
     stack[0, 1] = n
-    T.kd_stack_lb[0] = 0.0  # the depth of the range, stored as a float
+    stack[0, 2] = 0
     top = 1
     while top > 0:
         top -= 1
         lo = stack[top, 0]
         hi = stack[top, 1]
-        d = int(T.kd_stack_lb[top])
+        d = stack[top, 2]
         if hi - lo <= 0:
             continue
         mid = (lo + hi) // 2
         axis = d % dof
         _select(T.nodes, T.kd_perm, lo, hi, mid, axis)
-        depth[mid] = axis
+        T.kd_axis[mid] = axis
         if mid + 1 < hi:
             stack[top, 0] = mid + 1
             stack[top, 1] = hi
-            T.kd_stack_lb[top] = d + 1
+            stack[top, 2] = d + 1
             top += 1
         if lo < mid:
             stack[top, 0] = lo
             stack[top, 1] = mid
-            T.kd_stack_lb[top] = d + 1
+            stack[top, 2] = d + 1
             top += 1
     T.meta[KD_N] = n
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
-from xfuzzy_rrt.training.evaluate import Problem
+from xfuzzy_rrt.training.evaluate import TrainingProblem
 from xfuzzy_rrt.training.ga import GAConfig, generation_seeds, initial_population
 from xfuzzy_rrt.training.genome import encode
 from xfuzzy_rrt.training.workers import make_evaluator
@@ -37,7 +37,7 @@ def test_one_paper_scale_generation(benchmark, scenario):
         pop[::2] = np.clip(encode(*load_rulebook(paper).arrays())
                            + 0.01 * rng.standard_normal(pop[::2].shape), 0, 1)
     seeds = generation_seeds(0, 0, 5)
-    with make_evaluator([Problem.from_scenario(scenario)], "absolute", 10_000,
+    with make_evaluator([TrainingProblem.from_scenario(scenario)], "absolute", 10_000,
                         workers=os.cpu_count()) as evaluate:
         evaluate(pop[:8], seeds)  # start the workers
         t0 = time.perf_counter()
@@ -63,7 +63,7 @@ def test_one_goal_frame_generation_on_generated_problems(benchmark, scenario):
     goal-frame rulebook, as late in training."""
     from xfuzzy_rrt.scenarios.generate import generate_one
 
-    problems = [Problem.from_scenario(generate_one(4900, k).scenario) for k in range(32)]
+    problems = [TrainingProblem.from_scenario(generate_one(4900, k).scenario) for k in range(32)]
     config = GAConfig(population=120, bounds="goal-frame", scenarios=(("x", "-"),))
     rng = np.random.default_rng(0)
     pop = initial_population(config, rng)

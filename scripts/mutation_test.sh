@@ -4,7 +4,10 @@
 # What is mutated: xfuzzy_rrt/geometry/collision.py and geometry/kinematics.py (all of them),
 # planners/extend.py, and the path bookkeeping: tree.add_node, tree.extract_path and
 # result.path_cost_deg. Which tests judge: tests/test_safety_bounds.py, test_collision.py and
-# test_kinematics.py (override with MUTATION_TESTS="tests/a.py tests/b.py").
+# test_kinematics.py, the bound files named after each certified step (test_link_obstacle_bound,
+# test_arm_arm_bound with the head-on two-arm case, test_self_pair_bound with self-collision)
+# and the N-DOF files test_motion_bound_ndof.py and test_exact_geometry_ndof.py (override with
+# MUTATION_TESTS="tests/a.py tests/b.py").
 #
 # Why a copy: mutmut 3 writes its instrumented sources into ./mutants/ of the directory it runs
 # in, and mutmut skips decorated functions, i.e. every numba kernel. So the script copies the
@@ -15,11 +18,14 @@
 #
 # Usage:   scripts/mutation_test.sh [WORKDIR]          (default: a new /tmp/xfuzzy-mutation.*)
 #          scripts/mutation_test.sh --weaken F [WORKDIR]
-#            instead of mutmut: make the certified check F times non-conservative in the copy
-#            (a) the motion bound divided by F, (b) the advance multiplied by F, (c) the user
-#            clearance held F times too leniently by edge_free, (d) by effective_margin; run
-#            the safety tests (numba on) against each and print the failures. Exit 0 only when
-#            the suite fails for every one, i.e. the weakening is caught. Try F = 1.05.
+#            instead of mutmut: make one certified step F times non-conservative in the copy
+#            at a time -- (bound) M_k divided by F, (advance) the link-obstacle step
+#            (c_k - clear) / M_k multiplied by F, (armarm) the arm-arm bound M_k + M_m divided
+#            by F, (armarm-max) replaced by max(M_k, M_m), (selfpair) the self-pair relative
+#            bound divided by F, (clearance) the user clearance held F times too leniently by
+#            edge_free, (effective) by effective_margin, (radius) goal-frame clearance_deg
+#            multiplied by F -- and run the test files NAMED AFTER that bound (numba on)
+#            against each. Exit 0 only when every weakening fails its own tests. Try F = 1.05.
 # Env:     PYTHON (default .venv/bin/python), MUTATION_JOBS (default 1), MUTATION_TESTS,
 #          MUTATION_MUTANTS (mutant name globs, default: the safety core as above).
 # Needs:   mutmut >= 3.8 in that interpreter (.venv/bin/pip install mutmut).
@@ -38,7 +44,7 @@ PY=${PYTHON:-$ROOT/.venv/bin/python}
 MUTMUT=$(dirname "$PY")/mutmut
 JOBS=${MUTATION_JOBS:-1}
 WORK=${1:-$(mktemp -d /tmp/xfuzzy-mutation.XXXXXX)}
-TESTS=${MUTATION_TESTS:-tests/test_safety_bounds.py tests/test_collision.py tests/test_kinematics.py}
+TESTS=${MUTATION_TESTS:-tests/test_safety_bounds.py tests/test_collision.py tests/test_kinematics.py tests/test_link_obstacle_bound.py tests/test_arm_arm_bound.py tests/test_self_pair_bound.py tests/test_motion_bound_ndof.py tests/test_exact_geometry_ndof.py}
 MUTANTS=${MUTATION_MUTANTS:-"xfuzzy_rrt.geometry.collision.* xfuzzy_rrt.geometry.kinematics.* xfuzzy_rrt.planners.extend.* xfuzzy_rrt.planners.tree.x_add_node__mutmut_* xfuzzy_rrt.planners.tree.x_extract_path__mutmut_* xfuzzy_rrt.planners.result.x_path_cost_deg__mutmut_*"}
 FILES=(xfuzzy_rrt/geometry/collision.py xfuzzy_rrt/geometry/kinematics.py
        xfuzzy_rrt/planners/extend.py xfuzzy_rrt/planners/tree.py xfuzzy_rrt/planners/result.py)
@@ -62,40 +68,71 @@ fi
 cd "$WORK"
 if [ -n "$WEAKEN" ]; then
   status=0
-  for variant in bound advance clearance effective; do
-    cp "$ROOT/xfuzzy_rrt/geometry/collision.py" xfuzzy_rrt/geometry/collision.py
-    "$PY" - "$variant" "$WEAKEN" <<'PYEOF'
-"""Weaken the certified check in the copy: the bound M_k / F, or the advance ds * F."""
+  for variant in bound advance armarm armarm-max selfpair clearance effective radius; do
+    for f in xfuzzy_rrt/geometry/collision.py xfuzzy_rrt/planners/goal_frame.py; do
+      cp "$ROOT/$f" "$f"
+    done
+    find xfuzzy_rrt -name '*.nbi' -delete -o -name '*.nbc' -delete
+    named=$("$PY" - "$variant" "$WEAKEN" <<'PYEOF'
+"""Weaken one certified step in the copy; print the test files named after that bound."""
 import sys
 from pathlib import Path
 
 variant, factor = sys.argv[1], sys.argv[2]
-path = Path("xfuzzy_rrt/geometry/collision.py")
-text = path.read_text()
-old, new = {
-    "bound": ("        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk\n",
-              f"        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk / {factor}\n"),
-    "advance": ("                step = (ck - clear) / mk\n",
-                f"                step = (ck - clear) / mk * {factor}\n"),
-    # The user clearance (issue 18) held F times too leniently by the edge check ...
-    "clearance": ("    clear = margin - CERT_MARGIN_M\n",
-                  f"    clear = (margin - CERT_MARGIN_M) / {factor}\n    margin = CERT_MARGIN_M + clear if clear > 0.0 else margin\n"),
-    # ... or by the margin every planner is given for it.
-    "effective": ("    return CERT_MARGIN_M + float(clearance_m)\n",
-                  f"    return CERT_MARGIN_M + float(clearance_m) / {factor}\n"),
+collision = "xfuzzy_rrt/geometry/collision.py"
+F = factor
+file, old, new, tests = {
+    # M_k itself (every step that uses it: link-obstacle, arm-arm, self pairs) ...
+    "bound": (collision,
+              "        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk\n",
+              f"        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk / {F}\n",
+              "tests/test_link_obstacle_bound.py tests/test_safety_bounds.py"),
+    # ... the per-link obstacle step (c_k - clear) / M_k ...
+    "advance": (collision, "                        step = (ck - clear) / mk\n",
+                f"                        step = (ck - clear) / mk * {F}\n",
+                "tests/test_link_obstacle_bound.py tests/test_margins.py"),
+    # ... the arm-arm bound M_k + M_m, weakened by F or replaced by max (issue 22) ...
+    "armarm": (collision, "                            mkm = mka + mks[m]\n",
+               f"                            mkm = (mka + mks[m]) / {F}\n",
+               "tests/test_arm_arm_bound.py"),
+    "armarm-max": (collision, "                            mkm = mka + mks[m]\n",
+                   "                            mkm = max(mka, mks[m])\n",
+                   "tests/test_arm_arm_bound.py"),
+    # ... the self-pair relative bound ...
+    "selfpair": (collision, "    return link_motion_bound(links, qa_deg, qb_deg, m, k + 1)\n",
+                 f"    return link_motion_bound(links, qa_deg, qb_deg, m, k + 1) / {F}\n",
+                 "tests/test_self_pair_bound.py"),
+    # ... the user clearance (issue 18) held F times too leniently by edge_free ...
+    "clearance": (collision, "    clear = P.clearance\n",
+                  f"    clear = P.clearance / {F}\n    margin = margin - (P.clearance - clear)\n",
+                  "tests/test_margins.py"),
+    # ... or by the margin every planner is given for it ...
+    "effective": (collision, "    return CERT_MARGIN_M + float(clearance_m)\n",
+                  f"    return CERT_MARGIN_M + float(clearance_m) / {F}\n",
+                  "tests/test_margins.py"),
+    # ... and clearance_deg, the goal-frame input that claims a certified joint-space radius.
+    "radius": ("xfuzzy_rrt/planners/goal_frame.py",
+               "    deg_per_m = math.degrees(1.0) / problem_lever(P)\n",
+               f"    deg_per_m = math.degrees(1.0) / problem_lever(P) * {F}\n",
+               "tests/test_clearance_radius.py"),
 }[variant]
+path = Path(file)
+text = path.read_text()
 if text.count(old) != 1:
     sys.exit(f"error: cannot find the {variant} code to weaken in {path}")
 path.write_text(text.replace(old, new))
+print(tests)
 PYEOF
-    echo "== $variant weakened by a factor $WEAKEN:"
-    if PYTHONPATH="$WORK" nice -n 10 "$PY" -m pytest -q -p no:cacheprovider \
-        tests/test_safety_bounds.py tests/test_collision.py tests/test_margins.py > weaken-$variant.log 2>&1; then
-      echo "NOT CAUGHT: the suite passes with the $variant weakened by $WEAKEN"
+)
+    echo "== $variant weakened by a factor $WEAKEN (tests named after it: $named):"
+    # shellcheck disable=SC2086
+    if PYTHONPATH="$WORK" nice -n 10 "$PY" -m pytest -q -p no:cacheprovider -p no:randomly \
+        $named > weaken-$variant.log 2>&1; then
+      echo "NOT CAUGHT: $named pass with the $variant weakened by $WEAKEN"
       status=1
     else
-      grep -E "^FAILED|AssertionError: link|passed|failed" weaken-$variant.log | cut -c1-200
-      echo "caught: the suite fails (log: $WORK/weaken-$variant.log)"
+      grep -E "^FAILED|passed|failed" weaken-$variant.log | sed -E 's/ - .*//' | cut -c1-160 | head -6
+      echo "caught: $(grep -cE '^FAILED' weaken-$variant.log) failing tests (log: $WORK/weaken-$variant.log)"
     fi
   done
   exit $status

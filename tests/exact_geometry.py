@@ -4,8 +4,10 @@
 numpy; link segments are shapely LineStrings; circle obstacles are measured exactly as
 distance-to-centre minus radius (a buffered shapely circle would be a polygon approximation);
 boxes are exact shapely rectangles. A configuration collides when a link comes within
-``link_radius`` of an obstacle (touching counts). A scenario file with several arms is handed to
-the multi-arm oracle below (``Oracle.world``), which adds arm-arm contact.
+``link_radius`` of an obstacle (touching counts), or two non-adjacent links of the arm come
+within ``2 link_radius`` of each other (self-collision; links sharing a joint never count). A
+scenario file with several arms is handed to the multi-arm oracle below (``Oracle.world``),
+which adds arm-arm contact.
 
 ``World`` and the ``oracle_*`` functions (N links, several arms, plain numpy and math): exact
 plane distances including capsule-capsule contact between arms, and a proven bracket of the
@@ -98,6 +100,12 @@ class Oracle:
                 best = np.minimum(best, np.maximum(shapely.distance(segs, center) - r, 0.0) - self.radius)
             for b in self.boxes:
                 best = np.minimum(best, shapely.distance(segs, b) - self.radius)
+        # Self-collision: links i and j >= i + 2 of the arm (exact shapely segment distances).
+        for i in range(k):
+            si = shapely.linestrings(np.stack([pts[:, i], pts[:, i + 1]], axis=1))
+            for j in range(i + 2, k):
+                sj = shapely.linestrings(np.stack([pts[:, j], pts[:, j + 1]], axis=1))
+                best = np.minimum(best, shapely.distance(si, sj) - 2.0 * self.radius)
         return best
 
     def in_collision(self, q_deg: np.ndarray) -> np.ndarray:
@@ -208,7 +216,10 @@ class Oracle:
 # - ``dist(link segment, obstacle) - r_a`` for every link of every arm ``a`` and every obstacle
 #   (circles and axis-aligned boxes are closed sets: touching, clearance 0, is a collision), and
 # - ``dist(link segment of arm a, link segment of arm b) - r_a - r_b`` for every pair of links of
-#   two *different* arms (links of one arm never collide with each other).
+#   two *different* arms, and
+# - ``dist(link i, link j) - 2 r_a`` for every pair of links ``j >= i + 2`` of ONE arm ``a``
+#   (self-collision). Adjacent links share a joint point, so they never count: how far a joint
+#   folds (even to ±180°, one link on the other) is the joint limits' business.
 #
 # Distances are exact plane geometry evaluated in float64 (see the primitives):
 #
@@ -241,6 +252,13 @@ class Oracle:
 #   ``V_k``-Lipschitz in ``s`` and the link(a, k)-link(b, m) clearance is
 #   ``(V^a_k + V^b_m)``-Lipschitz. (``|Ω_i| <= Σ_{j<=i} |Δq_j|`` shows ``V_k <= M_k``, the
 #   package's bound; the property tests check the package's bound, not this one.)
+#
+#   Two links ``i < j`` of ONE arm: a distance is invariant under a rigid motion applied to both
+#   sets, so measure it in link ``i``'s own frame, where link ``i`` is fixed and a point of link
+#   ``j`` is ``l_i e(0) + Σ_{i<h<j} l_h e(ψ_h) + t l_j e(ψ_j)`` with ``ψ_h = Σ_{i<g<=h} q_g``;
+#   its speed is at most ``W_ij := Σ_{i<h<=j} l_h |Σ_{i<g<=h} Δq_g|`` (the same computation with
+#   the joints before ``i+1`` left out: they move both links together). So the self pair's
+#   clearance is ``W_ij``-Lipschitz.
 #
 #   A function ``f`` that is ``L``-Lipschitz on ``[s0, s1]`` (width ``h``) with end values
 #   ``f0, f1`` satisfies ``f(s) >= max(f0 - L (s - s0), f1 - L (s1 - s)) >= (f0 + f1 - L h) / 2``.
@@ -361,6 +379,11 @@ class World:
             for b in range(a + 1, len(self.arms)):
                 self._pairs += [("arm", a, k, b, m) for k in range(len(self.arms[a][0]))
                                 for m in range(len(self.arms[b][0]))]
+        # then per arm its non-adjacent link pairs (i, j >= i + 2), i-major
+        self._self = [[(i, j) for i in range(len(l)) for j in range(i + 2, len(l))]
+                      for l, _, _ in self.arms]
+        for a, pairs in enumerate(self._self):
+            self._pairs += [("self", a, i, a, j) for i, j in pairs]
 
     # -------------------------------------------------------------------------- construction
 
@@ -450,6 +473,13 @@ class World:
                 d = segment_segment_distance(pa[:, :-1, None, :], pa[:, 1:, None, :],
                                              pb[:, None, :-1, :], pb[:, None, 1:, :])
                 cols.append((d - ra - rb).reshape(m, -1))
+        for a, pairs in enumerate(self._self):
+            if pairs:
+                i = np.array([p[0] for p in pairs])
+                j = np.array([p[1] for p in pairs])
+                pa = pts[a]
+                d = segment_segment_distance(pa[:, i], pa[:, i + 1], pa[:, j], pa[:, j + 1])
+                cols.append((d - 2.0 * self.arms[a][2]).reshape(m, -1))
         if not cols:
             return np.zeros((m, 0))
         return np.concatenate(cols, axis=1)
@@ -464,7 +494,19 @@ class World:
         for a in range(len(self.arms)):
             for b in range(a + 1, len(self.arms)):
                 out.append((v[a][:, None] + v[b][None, :]).ravel())
+        dq = np.radians(np.asarray(qb_deg, dtype=float) - np.asarray(qa_deg, dtype=float))
+        for a, pairs in enumerate(self._self):
+            links = self.arms[a][0]
+            local = dq[self.first[a]:self.first[a + 1]]
+            out.append(np.array([self.self_pair_speed(links, local, i, j) for i, j in pairs]))
         return np.concatenate(out) if out else np.zeros(0)
+
+    @staticmethod
+    def self_pair_speed(links, dq_rad, i, j) -> float:
+        """``W_ij = Σ_{i<h<=j} l_h |Σ_{i<g<=h} Δq_g|`` (module notes): how fast link ``j``
+        moves in the frame of link ``i`` of the same arm."""
+        omega = np.abs(np.cumsum(dq_rad[i + 1:j + 1]))
+        return float(np.sum(links[i + 1:j + 1] * omega))
 
     def pair_floors(self) -> np.ndarray:
         """``[P]`` the least clearance a pair can have: distances are >= 0, so ``-r_a`` for a
@@ -477,13 +519,15 @@ class World:
             for b in range(a + 1, len(self.arms)):
                 out.append(np.full(len(self.arms[a][0]) * len(self.arms[b][0]),
                                    -self.arms[a][2] - self.arms[b][2]))
+        for a, pairs in enumerate(self._self):
+            out.append(np.full(len(pairs), -2.0 * self.arms[a][2]))
         return np.concatenate(out) if out else np.zeros(0)
 
     def pair_names(self) -> list[str]:
         """Readable names of the pairs, in :meth:`pair_clearances` column order."""
         names = []
         for kind, a, k, b, mm in self._pairs:
-            names.append(f"arm {a} link {k} / arm {b} link {mm}" if kind == "arm"
+            names.append(f"arm {a} link {k} / arm {b} link {mm}" if kind in ("arm", "self")
                          else f"arm {a} link {k} / {kind} {b}")
         return names
 

@@ -10,11 +10,11 @@ from xfuzzy_rrt.geometry import collision as _c
 from xfuzzy_rrt.geometry.problem import single_arm_problem
 
 
-def _problem(links, base, radius, obstacles, limits=None):
+def _problem(links, base, radius, obstacles, limits=None, margin=1e-6):
     links = np.asarray(links, dtype=np.float64)
     if limits is None:
         limits = np.tile([-180.0, 180.0], (links.shape[0], 1))
-    return single_arm_problem(links, base, radius, obstacles, limits)
+    return single_arm_problem(links, base, radius, obstacles, limits, margin=margin)
 
 
 def clearance_kernel(links, base, radius, obstacles, q_deg):
@@ -23,13 +23,14 @@ def clearance_kernel(links, base, radius, obstacles, q_deg):
 
 
 def edge_free(links, base, radius, obstacles, qa_deg, qb_deg, margin):
-    return _c.edge_free(_problem(links, base, radius, obstacles),
+    # the bundle carries the clearance this margin stands for, as ScenarioArrays.problem does
+    return _c.edge_free(_problem(links, base, radius, obstacles, margin=margin),
                         np.asarray(qa_deg, dtype=np.float64),
                         np.asarray(qb_deg, dtype=np.float64), margin)
 
 
 def config_free(links, base, radius, obstacles, limits, q_deg, margin):
-    return _c.config_free(_problem(links, base, radius, obstacles, limits),
+    return _c.config_free(_problem(links, base, radius, obstacles, limits, margin=margin),
                           np.asarray(q_deg, dtype=np.float64), margin)
 
 

@@ -124,11 +124,16 @@ def test_crossing_arms_collide_and_separated_arms_do_not():
     assert not oracle_path_is_free(w, [q_apart, q_cross])
 
 
-def test_links_of_one_arm_never_collide_with_each_other():
+def test_non_adjacent_links_of_one_arm_collide_and_adjacent_ones_never_do():
     w = World([([0.5, 0.5, 0.5], (0, 0), 0.05)])
-    folded = [0.0, 180.0, 180.0]  # the arm folds back onto itself
-    assert oracle_clearance(w, folded)[0] == math.inf
-    assert not oracle_in_collision(w, folded)[0]
+    folded = [0.0, 180.0, 180.0]  # the arm folds back onto itself: link 2 lies on link 0
+    assert oracle_clearance(w, folded)[0] == pytest.approx(-0.1)  # -2 r: the capsules overlap
+    assert oracle_in_collision(w, folded)[0]
+    assert w.pair_names()[-1] == "arm 0 link 0 / arm 0 link 2"
+    # two links share a joint: folded flat they are the joint limits' business, not a contact
+    two = World([([0.5, 0.5], (0, 0), 0.05)])
+    assert oracle_clearance(two, [0.0, 180.0])[0] == math.inf
+    assert not oracle_in_collision(two, [0.0, 180.0])[0]
 
 
 @pytest.mark.parametrize("gap, colliding", [(0.0, True), (1e-9, False), (-1e-9, True)])
@@ -207,10 +212,15 @@ def test_seven_link_arm_wrapping_an_obstacle_matches_brute_force():
     # the box's left side is at 0.45 while the heptagon's rightmost point is the base (0.4, 0).
     want_circle = 0.4 * math.cos(math.pi / 7) - 0.3 - r_link
     want_box = 0.45 - 0.4 - r_link
+    # The closed chain touches itself: the last link ends where the first begins (links 0 and
+    # 6 share the base point), a self-collision of depth 2 r_link.
     c = oracle_clearance(w, q)[0]
-    assert c == pytest.approx(min(want_circle, want_box), abs=1e-14)
+    assert c == pytest.approx(-2.0 * r_link, abs=1e-12)
     pc = w.pair_clearances(q)[0]
     names = w.pair_names()
+    assert names[int(np.argmin(pc))] == "arm 0 link 0 / arm 0 link 6"
+    obstacle_cols = [i for i, nm in enumerate(names) if "circle" in nm or "box" in nm]
+    assert pc[obstacle_cols].min() == pytest.approx(min(want_circle, want_box), abs=1e-14)
     circle_cols = [i for i, nm in enumerate(names) if "circle" in nm]
     assert pc[circle_cols].min() == pytest.approx(want_circle, abs=1e-14)
     # Brute force over dense link points.

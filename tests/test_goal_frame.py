@@ -28,7 +28,7 @@ from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
 from xfuzzy_rrt.planners.goal_frame import arm_lever
 from xfuzzy_rrt.planners.rrt import plan_rrt
-from xfuzzy_rrt.training.evaluate import Problem, iterations_for, log_ratio_fitness
+from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for, log_ratio_fitness
 from xfuzzy_rrt.training.genome import constant_outputs_genome, decode, encode
 
 SCENARIOS = [FIXTURES / "scenarios" / "two-circles.toml", FIXTURES / "scenarios" / "boxes-and-circle.toml"]
@@ -198,7 +198,7 @@ def test_compiled_goal_frame_evaluation_matches_the_planner_run_for_run():
     genes = np.clip(base + 0.1 * rng.standard_normal((3, base.size)), 0, 1)
     knots, consts = decode(genes, "goal-frame")
     seeds = np.array([3, 4])
-    its = iterations_for([Problem.from_scenario(s) for s in scenarios], knots, consts,
+    its = iterations_for([TrainingProblem.from_scenario(s) for s in scenarios], knots, consts,
                          "goal-frame", seeds, 3000)
     for p in range(3):
         rb = Rulebook.from_arrays(knots[p], consts[p], name="x", bounds_mode=None,

@@ -55,7 +55,8 @@ def link_point_paths(links, base, qa, qb, k, s, us):
 
 
 def exact_clearance(links, base, radius, obstacles, q_deg) -> float:
-    """Clearance by shapely: min over links and obstacles of distance minus ``radius``."""
+    """Clearance by shapely: min over links and obstacles of distance minus ``radius``, and
+    over non-adjacent link pairs of distance minus ``2 radius`` (self-collision)."""
     pts = joint_points(links, base, q_deg)[0]
     best = math.inf
     for k in range(len(links)):
@@ -66,6 +67,9 @@ def exact_clearance(links, base, radius, obstacles, q_deg) -> float:
             else:
                 d = seg.distance(shapely.box(ob[1], ob[2], ob[3], ob[4]))
             best = min(best, d - radius)
+        for m in range(k + 2, len(links)):
+            other = shapely.LineString([pts[m], pts[m + 1]])
+            best = min(best, seg.distance(other) - 2.0 * radius)
     return best
 
 

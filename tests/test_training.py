@@ -20,7 +20,7 @@ from xfuzzy_rrt.fuzzy.rulebook import Rulebook, load_rulebook, save_rulebook
 from xfuzzy_rrt.fuzzy.variables import INPUT_RANGES, INPUTS, OUTPUT_RANGES, OUTPUTS
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
-from xfuzzy_rrt.training.evaluate import Problem, fitness, iterations_for
+from xfuzzy_rrt.training.evaluate import TrainingProblem, fitness, iterations_for
 from xfuzzy_rrt.training.ga import GAConfig, generation_seeds, initial_population
 from xfuzzy_rrt.training.genome import N_GENES, constant_genome, decode, encode
 
@@ -97,7 +97,7 @@ def test_compiled_evaluation_matches_the_planner_run_for_run():
         0.3, (-60, 60, -60, 60), 10.0) * 0.8
     knots, consts = decode(genes)
     seeds = np.array([11, 12, 13])
-    its = iterations_for([Problem.from_scenario(s) for s in scenarios], knots, consts,
+    its = iterations_for([TrainingProblem.from_scenario(s) for s in scenarios], knots, consts,
                          "relative", seeds, 3000)
     for p in range(3):
         rb = Rulebook.from_arrays(knots[p], consts[p], name="x", bounds_mode="relative",
@@ -114,7 +114,7 @@ def test_fitness_is_the_papers_mean_reward():
 
 
 def test_seeded_first_generation_solves_problems_where_random_rulebooks_fail():
-    problems = [Problem.from_scenario(load_scenario(SCENARIOS[0]))]
+    problems = [TrainingProblem.from_scenario(load_scenario(SCENARIOS[0]))]
     seeds = generation_seeds(0, 0, 3)
     result = {}
     for init in ("seeded", "random"):

@@ -31,14 +31,14 @@ import numpy as np
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.collision import (
     CERT_MARGIN_M,
+    MIN_CLEARANCE_TOL_M,
     check_clearance,
     clearance_kernel,
     effective_margin,
+    has_self_pairs,
 )
 from xfuzzy_rrt.geometry.signed import element_clearances, element_motion_bounds, n_elements
 
-#: The exact minimum clearance along a path is bracketed to within this (metres).
-MIN_CLEARANCE_TOL_M = 1e-9
 #: Distance evaluations per path after which the search reports its proven lower bound.
 MIN_CLEARANCE_MAX_EVALS = 2_000_000
 
@@ -145,15 +145,16 @@ def min_clearance_kernel(P, path, tol, max_evals, decide_contact):
     ``tol`` of touching pay for the sign.
 
     Branch and bound per segment with one Lipschitz constant per element (a link against the
-    obstacles, ``M_k``, or a pair of links of different arms, ``M_k + M_m``; see
-    ``geometry/signed.py``): inner links move less, so a link that is far from everything
+    obstacles, ``M_k``, a pair of links of different arms, ``M_k + M_m``, or two non-adjacent
+    links of one arm, their relative bound; see ``geometry/signed.py``): inner links move less, so a link that is far from everything
     stops costing evaluations early;
     segments are visited in the order of their initial bound, so the best value is tight
     early and prunes the rest.
     """
     n = path.shape[0]
     nl = n_elements(P)
-    if (P.obstacles.shape[0] == 0 and P.arm_first.shape[0] == 2) or n == 0:
+    if (P.obstacles.shape[0] == 0 and P.arm_first.shape[0] == 2 and not has_self_pairs(P)) \
+            or n == 0:
         return np.inf, -1, 0.0, np.inf
     cv = np.empty((n, nl))
     best = np.inf

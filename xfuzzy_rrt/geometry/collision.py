@@ -20,9 +20,11 @@ every step is at least ``margin / max_k M_k`` long. Nodes are held to the same m
 every edge leaving an accepted node can be certified.
 
 **A surgeon's clearance (certified).** A user clearance ``c`` (metres; ``[safety] clearance_m``
-or ``--clearance``) enters the kernels folded into the one ``margin`` they already carry:
-``margin = effective_margin(c) = CERT_MARGIN_M + c``. ``edge_free`` recovers the clearance as
-``clear = margin - CERT_MARGIN_M`` and treats ``c_k - clear`` as the free distance: it steps by
+or ``--clearance``) travels in the problem bundle as its own field ``P.clearance``, next to
+``margin = effective_margin(c) = CERT_MARGIN_M + c`` (the bundle is built by
+``ScenarioArrays.problem``, which derives the clearance from the margin in one place,
+:func:`clearance_of_margin`). ``edge_free`` reads ``clear = P.clearance`` and treats
+``c_k - clear`` as the free distance: it steps by
 ``min_k (c_k - clear) / M_k`` and fails when a stop has ``c_k <= margin`` (i.e. ``c_k - clear``
 at most the 1 µm termination slack). Why this holds the clearance *everywhere* on the segment,
 not only at the stops: between two stops ``s`` and ``s + ds`` link *k* keeps at least
@@ -33,6 +35,21 @@ from every obstacle along every certified segment. With ``c = 0`` (the default),
 exactly ``0.0`` and ``c_k - 0.0 == c_k`` in floating point: the arithmetic, hence every plan, is
 bit-for-bit the one without a clearance (tests/test_golden.py). Margins below ``CERT_MARGIN_M``
 (tests use them) are treated as a clearance of 0.
+
+**Bodies that count.** Every link capsule against every obstacle; every pair of links of two
+different arms (their distance is ``(M_k + M_m)``-Lipschitz: each link moves with its own arm's
+joints); and every pair of *non-adjacent* links of one arm, ``|k - m| >= 2`` (self-collision,
+:func:`self_pair_motion_bound`). Adjacent links share a joint point, so their capsules always
+overlap there: they are never a collision, whatever the joint angle, even folded back at ±180°
+onto each other -- how far a joint may fold is what its joint limits say (a real joint's
+mechanical stop), not a distance test. A two-link arm has no non-adjacent pair, so every 2-DOF
+result is the one without self-collision, bit for bit; a three-link arm has one pair, (0, 2).
+The user clearance is held between any two bodies alike.
+
+**Work.** ``P.work[0]`` counts exact element distances (one per link-obstacle pair, per link
+pair of two arms, per non-adjacent link pair of one arm) evaluated by :func:`clearance_kernel`
+and :func:`edge_free` (so :func:`config_free` too): a deterministic measure of planning work.
+It is only ever incremented, never read, by the kernels, so it cannot change a result.
 """
 
 from __future__ import annotations
@@ -47,10 +64,31 @@ from xfuzzy_rrt.geometry.kinematics import fk_step
 
 #: Minimum clearance (metres) a configuration must keep to count as free for the planners.
 CERT_MARGIN_M = 1e-6
+#: The exact minimum clearance along a path (``clearance.path_min_clearance``,
+#: ``path_check.certify_path``) is bracketed to within this (metres): 0.1 µm, a tenth of
+#: ``CERT_MARGIN_M``, so a reported minimum can never hide a violation of the certification
+#: margin, yet it is 100x coarser than float64 noise at arm scale (~1e-15 m) and cheap: a tighter
+#: 1 nm costs ~8x the distance evaluations near smooth minima, where the Lipschitz bound
+#: converges like the square root of the tolerance. One constant for both callers (they
+#: used to disagree, 1e-7 and 1e-9).
+MIN_CLEARANCE_TOL_M = 1e-7
 #: Largest user clearance accepted (metres): beyond 1 m no arm in scope has any free space.
 MAX_CLEARANCE_M = 1.0
 
 _TWO_PI = 2.0 * math.pi
+
+
+def clearance_of_margin(margin: float) -> float:
+    """The user clearance a kernel ``margin`` stands for: ``margin - CERT_MARGIN_M``, or exactly
+    ``0.0`` when that is not positive (the default margin, and the smaller margins tests use).
+
+    The one place the clearance is recovered from a margin (``ScenarioArrays.problem`` stores it
+    in ``P.clearance``; kernels read that field). For ``effective_margin(c)`` it is ``c`` up to
+    one rounding of the sum; ``clearance_of_margin(CERT_MARGIN_M)`` is exactly 0.0, so the
+    certified step ``(c_k - 0.0) / M_k`` is bit for bit the one without a clearance.
+    """
+    clear = float(margin) - CERT_MARGIN_M
+    return clear if clear > 0.0 else 0.0
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -215,9 +253,50 @@ def arm_arm_clearance(P, seg):
 
 
 @nb.njit(cache=True, nogil=True)
+def has_self_pairs(P):
+    """Does some arm have two non-adjacent links (three links or more)?"""
+    for a in range(P.arm_first.shape[0] - 1):
+        if P.arm_first[a + 1] - P.arm_first[a] >= 3:
+            return True
+    return False
+
+
+@nb.njit(cache=True, nogil=True)
+def self_clearance(P, seg):
+    """Smallest capsule-capsule distance between non-adjacent links of one arm (``inf``: no arm
+    has three links). Adjacent links share a joint and never count (module docstring)."""
+    best = np.inf
+    for a in range(P.arm_first.shape[0] - 1):
+        rr = P.radii[a] + P.radii[a]
+        for k in range(P.arm_first[a], P.arm_first[a + 1]):
+            for m in range(k + 2, P.arm_first[a + 1]):
+                d = segment_segment_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
+                                         seg[m, 0], seg[m, 1], seg[m, 2], seg[m, 3]) - rr
+                if d < best:
+                    best = d
+    return best
+
+
+@nb.njit(cache=True, nogil=True)
+def n_distance_pairs(P):
+    """Exact element distances one configuration costs: links x obstacles, link pairs of two
+    arms and non-adjacent link pairs of one arm (the unit of ``P.work``)."""
+    n = P.links.shape[0] * P.obstacles.shape[0]
+    n_arms = P.arm_first.shape[0] - 1
+    for a in range(n_arms):
+        na = P.arm_first[a + 1] - P.arm_first[a]
+        if na >= 3:
+            n += (na - 1) * (na - 2) // 2
+        for b in range(a + 1, n_arms):
+            n += na * (P.arm_first[b + 1] - P.arm_first[b])
+    return n
+
+
+@nb.njit(cache=True, nogil=True)
 def clearance_kernel(P, q_deg):
-    """Smallest distance between any link capsule and any obstacle or any other arm's capsule
-    (<= 0: collision); ``inf`` for one arm without obstacles. Joint limits are not considered.
+    """Smallest distance between any link capsule and any obstacle, any other arm's capsule or
+    a non-adjacent link of its own arm (<= 0: collision); ``inf`` with nothing to touch. Joint
+    limits are not considered.
     """
     best = np.inf
     n_arms = P.arm_first.shape[0] - 1
@@ -230,10 +309,15 @@ def clearance_kernel(P, q_deg):
             best = min(best, _link_clearance(x, y, nx, ny, P.radii[a], P.obstacles))
             x = nx
             y = ny
-    if n_arms > 1:
+    has_self = has_self_pairs(P)
+    if n_arms > 1 or has_self:
         seg = np.empty((P.links.shape[0], 4))
         link_segments_into(P, q_deg, seg)
-        best = min(best, arm_arm_clearance(P, seg))
+        if n_arms > 1:
+            best = min(best, arm_arm_clearance(P, seg))
+        if has_self:
+            best = min(best, self_clearance(P, seg))
+    P.work[0] += n_distance_pairs(P)
     return best
 
 
@@ -274,34 +358,70 @@ def link_motion_bound(links, qa_deg, qb_deg, k, first=0):
 
 
 @nb.njit(cache=True, nogil=True)
+def self_pair_motion_bound(links, qa_deg, qb_deg, k, m):
+    """Lipschitz constant (m per unit ``s``) of the distance between links ``k < m`` of ONE arm
+    (``m >= k + 2``) along ``qa -> qb``: ``link_motion_bound(links, qa, qb, m, first=k + 1)``.
+
+    Proof. A distance between two sets is unchanged by a rigid motion of the plane applied to
+    both, so measure it, at every ``s``, in the frame of link ``k`` (origin at its base, x along
+    it). There link ``k`` is the fixed segment ``[0, l_k] x {0}``, and a point at fraction ``t``
+    of link ``m`` is ``l_k e(0) + Σ_{k<i<m} l_i e(φ_i) + t l_m e(φ_m)`` with
+    ``φ_i = Σ_{k<j<=i} q_j`` (``e(φ) = (cos φ, sin φ)``): only the joints ``k+1 .. m`` between
+    the two links move it, each at the constant rate ``Δq_j`` (radians per unit ``s``). Its speed
+    is at most ``Σ_{k<i<=m} l_i |φ_i'| <= Σ_{k<j<=m} |Δq_j| Σ_{i=j..m} l_i`` -- the motion bound
+    of link ``m`` of the sub-arm that starts at joint ``k + 1``. A point moving that fast changes
+    its distance to a fixed set no faster, and the distance between the fixed segment ``k`` and
+    the moving segment ``m`` (a minimum over their points) is then Lipschitz with the same
+    constant; the capsule radii subtract a constant. The joints before link ``k`` move both links
+    rigidly together and do not count -- tighter than ``M_k + M_m`` (the bound for links of two
+    arms), which would also be sound. ``edge_free`` steps by ``(d - clear) / this``.
+    """
+    return link_motion_bound(links, qa_deg, qb_deg, m, k + 1)
+
+
+@nb.njit(cache=True, nogil=True)
 def edge_free(P, qa_deg, qb_deg, margin):
     """Certified check of the straight joint segment ``qa -> qb`` (conservative advancement).
 
-    Returns True only if every configuration on the segment keeps clearance >=
-    ``margin - CERT_MARGIN_M`` (the user clearance; > 0 when that is 0) and the sampled stops
-    keep clearance > ``margin``, against obstacles and between arms. Both endpoints must be
-    within the joint limits already (the box is convex, so the whole segment then is). See the
-    module docstring; for two links of different arms the Lipschitz constant of their distance
-    is the sum of the two links' motion bounds, each from its own arm's joints.
+    Returns True only if every configuration on the segment keeps clearance >= ``P.clearance``
+    (the user clearance; > 0 when that is 0) and the sampled stops keep clearance > ``margin``,
+    against obstacles, between arms and between non-adjacent links of one arm. Both endpoints
+    must be within the joint limits already (the box is convex, so the whole segment then is).
+    See the module docstring; for two links of different arms the Lipschitz constant of their
+    distance is the sum of the two links' motion bounds, each from its own arm's joints; for two
+    links of one arm it is :func:`self_pair_motion_bound`. A ``margin`` below ``P.clearance``
+    (an inconsistent call: the steps would go backwards) certifies nothing.
     """
     n_arms = P.arm_first.shape[0] - 1
     obstacles = P.obstacles
     has_obstacles = obstacles.shape[0] > 0
-    if not has_obstacles and n_arms == 1:
+    has_self = has_self_pairs(P)
+    if not has_obstacles and n_arms == 1 and not has_self:
         return True
-    # The user clearance folded into ``margin`` (exactly 0.0 for the default margin).
-    clear = margin - CERT_MARGIN_M
-    if not clear > 0.0:
-        clear = 0.0
-    seg = np.empty((P.links.shape[0] if n_arms > 1 else 0, 4))
+    # The user clearance (exactly 0.0 for the default margin: clearance_of_margin).
+    clear = P.clearance
+    if margin < clear:
+        return False
+    n_links = P.links.shape[0]
+    need_seg = n_arms > 1 or has_self
+    seg = np.empty((n_links if need_seg else 0, 4))
     # The motion bounds depend only on the segment: computed once, not at every stop.
-    mks = np.empty(P.links.shape[0])
+    mks = np.empty(n_links)
     for a in range(n_arms):
         first = P.arm_first[a]
         for k in range(first, P.arm_first[a + 1]):
             mks[k] = link_motion_bound(P.links, qa_deg, qb_deg, k, first)
+    # Self pairs (k, m >= k + 2 of one arm): their relative motion bound, in msf[k, m].
+    msf = np.empty((n_links if has_self else 0, n_links if has_self else 0))
+    if has_self:
+        for a in range(n_arms):
+            for k in range(P.arm_first[a], P.arm_first[a + 1]):
+                for m in range(k + 2, P.arm_first[a + 1]):
+                    msf[k, m] = self_pair_motion_bound(P.links, qa_deg, qb_deg, k, m)
+    per_stop = n_distance_pairs(P)
     s = 0.0
     while True:
+        P.work[0] += per_stop
         # Per-link clearance at q(s) and the safe advance it buys.
         cmin = np.inf
         ds = np.inf
@@ -314,7 +434,7 @@ def edge_free(P, qa_deg, qb_deg, margin):
                 if s >= 1.0:
                     qk = qb_deg[k]
                 nx, ny, theta = fk_step(x, y, theta, P.links[k], qk)
-                if n_arms > 1:
+                if need_seg:
                     seg[k, 0] = x
                     seg[k, 1] = y
                     seg[k, 2] = nx
@@ -354,6 +474,22 @@ def edge_free(P, qa_deg, qb_deg, margin):
                                 step = (d - clear) / mkm
                                 if step < ds:
                                     ds = step
+        if has_self:
+            for a in range(n_arms):
+                rr = P.radii[a] + P.radii[a]
+                for k in range(P.arm_first[a], P.arm_first[a + 1]):
+                    for m in range(k + 2, P.arm_first[a + 1]):
+                        d = segment_segment_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
+                                                 seg[m, 0], seg[m, 1], seg[m, 2], seg[m, 3]) - rr
+                        if not d < np.inf:
+                            return False
+                        if d < cmin:
+                            cmin = d
+                        mkm = msf[k, m]
+                        if mkm > 0.0:
+                            step = (d - clear) / mkm
+                            if step < ds:
+                                ds = step
         if cmin <= margin:
             return False
         if s >= 1.0:
@@ -459,13 +595,33 @@ def direction_and_distance(px, py, tx, ty):
 
 def clearance(arrays, q_deg) -> float:
     """Clearance of configuration ``q_deg`` in a :class:`ScenarioArrays` (<= 0: collision),
-    against obstacles and between arms."""
+    against obstacles, between arms and between non-adjacent links of one arm."""
     return float(clearance_kernel(arrays.problem(CERT_MARGIN_M),
                                   np.asarray(q_deg, dtype=np.float64)))
 
 
+def self_contact(arrays, q_deg) -> tuple[float, int, int]:
+    """``(clearance, k, m)``: the closest pair of non-adjacent links of one arm at ``q_deg``
+    (global link indices, ``k < m``; ``(inf, -1, -1)`` when no arm has three links). A
+    clearance <= 0 is a self-collision; the scenario loader names the pair with it."""
+    P = arrays.problem(CERT_MARGIN_M)
+    q = np.asarray(q_deg, dtype=np.float64)
+    seg = np.empty((P.links.shape[0], 4))
+    link_segments_into(P, q, seg)
+    best, bk, bm = math.inf, -1, -1
+    for a in range(P.arm_first.shape[0] - 1):
+        rr = P.radii[a] + P.radii[a]
+        for k in range(P.arm_first[a], P.arm_first[a + 1]):
+            for m in range(k + 2, P.arm_first[a + 1]):
+                d = float(segment_segment_dist(*seg[k], *seg[m])) - rr
+                if d < best:
+                    best, bk, bm = d, k, m
+    return best, bk, bm
+
+
 def in_collision(arrays, q_deg) -> bool:
-    """True when ``q_deg`` violates a joint limit or a link touches an obstacle or another arm."""
+    """True when ``q_deg`` violates a joint limit or a link touches an obstacle, another arm or
+    a non-adjacent link of its own arm."""
     q = np.asarray(q_deg, dtype=np.float64)
     if not within_limits(arrays.limits_deg, q):
         return True

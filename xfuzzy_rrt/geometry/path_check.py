@@ -46,7 +46,12 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, edge_free, within_limits
+from xfuzzy_rrt.geometry.collision import (  # noqa: F401  (MIN_CLEARANCE_TOL_M: re-exported)
+    CERT_MARGIN_M,
+    MIN_CLEARANCE_TOL_M,
+    edge_free,
+    within_limits,
+)
 # Signed distances live in geometry/signed.py; re-exported here, where callers used to find them.
 from xfuzzy_rrt.geometry.signed import (  # noqa: F401
     signed_clearance,
@@ -54,10 +59,6 @@ from xfuzzy_rrt.geometry.signed import (  # noqa: F401
     signed_segment_obstacle_dist,
 )
 
-#: The exact minimum clearance along a path is bracketed to within this (metres): 0.1 um, a
-#: tenth of the certification margin. (1 nm costs ~8x the distance evaluations near smooth
-#: minima, where the Lipschitz bound converges slowly.)
-MIN_CLEARANCE_TOL_M = 1e-7
 #: Distance evaluations per path after which the branch and bound stops refining and reports
 #: its proven lower bound instead (only reached when the clearance stays within the tolerance of its
 #: minimum over a long stretch, e.g. a link turning about the centre of a circle).

@@ -175,12 +175,20 @@ class ScenarioArrays:
             radii=np.asarray([arm.link_radius for arm in arms], dtype=np.float64),
         )
 
-    def problem(self, margin: float):
-        """The compiled problem bundle every kernel takes (:class:`~xfuzzy_rrt.geometry.problem.Problem`)."""
-        from xfuzzy_rrt.geometry.problem import Problem
+    def problem(self, margin: float, clearance: float | None = None):
+        """The compiled problem bundle every kernel takes (:class:`~xfuzzy_rrt.geometry.problem.Problem`).
 
+        ``clearance`` is the surgeon's clearance (m); by default the one ``margin`` stands for
+        (``margin - CERT_MARGIN_M`` when positive, else 0: ``collision.clearance_of_margin``).
+        Each call gets a fresh zeroed ``work`` counter, so a plan's count starts at 0.
+        """
+        from xfuzzy_rrt.geometry.collision import clearance_of_margin
+        from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
+
+        clear = clearance_of_margin(margin) if clearance is None else float(clearance)
         return Problem(self.links, self.arm_first, self.bases, self.radii, self.obstacles,
-                       self.limits_deg, self.start_deg, self.goal_deg, float(margin))
+                       self.limits_deg, self.start_deg, self.goal_deg, float(margin), clear,
+                       new_work_counter())
 
 
 # --------------------------------------------------------------------------------------------
@@ -476,13 +484,14 @@ def _read_arms(r: _Reader, data: dict[str, Any]):
 def _check_endpoints(s: Scenario, r: _Reader, arms_form: bool = False) -> None:
     """Start and goal must be within the joint limits and collision-free (touching counts).
 
-    Each arm is checked against the obstacles on its own (so the message names the arm), then
-    the whole configuration with :func:`~xfuzzy_rrt.geometry.collision.clearance`, which also
-    counts contact between two arms.
+    Each arm is checked on its own (so the message names the arm): first against itself (two
+    non-adjacent links meeting, self-collision), then against the obstacles; then the whole
+    configuration with :func:`~xfuzzy_rrt.geometry.collision.clearance`, which also counts
+    contact between two arms.
     """
     from dataclasses import replace
 
-    from xfuzzy_rrt.geometry.collision import clearance
+    from xfuzzy_rrt.geometry.collision import clearance, self_contact
 
     arrays = s.arrays()
     slices = s.arm_slices()
@@ -496,6 +505,10 @@ def _check_endpoints(s: Scenario, r: _Reader, arms_form: bool = False) -> None:
                                  f"{angle:g} deg is outside the joint limits [{lo:g}, {hi:g}]")
             alone = arrays if len(s.arms) == 1 else replace(
                 s, arm=arm, more_arms=(), arm_names=(), start_deg=q[sl], goal_deg=q[sl]).arrays()
+            own, k, m = self_contact(alone, np.asarray(q[sl], dtype=np.float64))
+            if own <= 0.0:
+                raise r.fail(key, f"configuration {list(q[sl])} is in self-collision: links "
+                             f"{k} and {m} of the arm (counted from 0) touch or overlap")
             if clearance(alone, np.asarray(q[sl], dtype=np.float64)) <= 0.0:
                 raise r.fail(key, f"configuration {list(q[sl])} is in collision "
                              f"(an arm link touches or overlaps an obstacle)")

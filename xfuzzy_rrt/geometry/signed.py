@@ -8,7 +8,9 @@ two link segments of different arms. Outside, every function agrees with the uns
 
 ``element_clearances`` is the view the Lipschitz branch and bound of ``clearance.py`` works on:
 one signed clearance per *element* -- each link against the obstacles, then each pair of links
-of different arms -- with ``element_motion_bounds`` the matching Lipschitz constants.
+of different arms, then each pair of non-adjacent links of one arm (self-collision) -- with
+``element_motion_bounds`` the matching Lipschitz constants (``M_k``, ``M_k + M_m``, and
+``collision.self_pair_motion_bound`` for a self pair).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from xfuzzy_rrt.geometry.collision import (
     _point_segment_dist,
     link_motion_bound,
     link_segments_into,
+    self_pair_motion_bound,
     segment_obstacle_dist,
     segment_segment_dist,
 )
@@ -103,10 +106,14 @@ def signed_segment_segment_dist(ax, ay, bx, by, cx, cy, dx, dy):
 
 @nb.njit(cache=True, nogil=True)
 def n_elements(P):
-    """Links (each against the obstacles) plus pairs of links of different arms."""
+    """Links (each against the obstacles), pairs of links of different arms, and pairs of
+    non-adjacent links of one arm."""
     n = P.links.shape[0]
     n_arms = P.arm_first.shape[0] - 1
     for a in range(n_arms):
+        na = P.arm_first[a + 1] - P.arm_first[a]
+        if na >= 3:
+            n += (na - 1) * (na - 2) // 2
         for b in range(a + 1, n_arms):
             n += (P.arm_first[a + 1] - P.arm_first[a]) * (P.arm_first[b + 1] - P.arm_first[b])
     return n
@@ -117,7 +124,8 @@ def element_clearances(P, q_deg, out):
     """Signed clearance of every element (see the module docstring) into ``out``; the min.
 
     Elements ``0 .. L-1`` are the links against all obstacles (``inf`` without obstacles),
-    then the link pairs of arms ``a < b`` in order. With one arm this is one value per link.
+    then the link pairs of arms ``a < b`` in order, then per arm its non-adjacent link pairs
+    ``(k, m >= k + 2)`` in order. With one arm of two links this is one value per link.
     """
     best = np.inf
     n_arms = P.arm_first.shape[0] - 1
@@ -149,13 +157,24 @@ def element_clearances(P, q_deg, out):
                     if d < best:
                         best = d
                     e += 1
+    for a in range(n_arms):
+        rr = P.radii[a] + P.radii[a]
+        for k in range(P.arm_first[a], P.arm_first[a + 1]):
+            for m in range(k + 2, P.arm_first[a + 1]):
+                d = signed_segment_segment_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
+                                                seg[m, 0], seg[m, 1], seg[m, 2], seg[m, 3]) - rr
+                out[e] = d
+                if d < best:
+                    best = d
+                e += 1
     return best
 
 
 @nb.njit(cache=True, nogil=True)
 def element_motion_bounds(P, qa_deg, qb_deg, out):
     """Lipschitz constant (m per unit of the segment ``qa -> qb``) of every element's clearance:
-    ``M_k`` of its link, or ``M_k + M_m`` for a pair of links of different arms."""
+    ``M_k`` of its link, ``M_k + M_m`` for a pair of links of different arms, the relative
+    bound ``self_pair_motion_bound`` for two non-adjacent links of one arm."""
     n_arms = P.arm_first.shape[0] - 1
     for a in range(n_arms):
         f = P.arm_first[a]
@@ -168,6 +187,11 @@ def element_motion_bounds(P, qa_deg, qb_deg, out):
                 for m in range(P.arm_first[b], P.arm_first[b + 1]):
                     out[e] = out[k] + out[m]
                     e += 1
+    for a in range(n_arms):
+        for k in range(P.arm_first[a], P.arm_first[a + 1]):
+            for m in range(k + 2, P.arm_first[a + 1]):
+                out[e] = self_pair_motion_bound(P.links, qa_deg, qb_deg, k, m)
+                e += 1
 
 
 @nb.njit(cache=True, nogil=True)

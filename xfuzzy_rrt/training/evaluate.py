@@ -63,10 +63,11 @@ def run_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_st
 
 
 @dataclass(frozen=True)
-class Problem:
-    """One scenario as the compiled problem bundle the kernels take (picklable: sent once to
-    each worker). ``groups``: fuzzy evaluations per iteration under the paper's semantics (one
-    per arm)."""
+class TrainingProblem:
+    """One training scenario: its name and the compiled problem bundle the kernels take
+    (``bundle``, a :class:`xfuzzy_rrt.geometry.problem.Problem`; picklable: sent once to each
+    worker). ``groups``: fuzzy evaluations per iteration under the paper's semantics (one per
+    arm). Named apart from the geometry ``Problem`` so one name means one thing."""
 
     name: str
     bundle: object
@@ -81,7 +82,7 @@ class Problem:
         return int(self.bundle.start.shape[0])
 
     @classmethod
-    def from_scenario(cls, scenario) -> "Problem":
+    def from_scenario(cls, scenario) -> "TrainingProblem":
         from xfuzzy_rrt.geometry.clearance import planning_margin
         from xfuzzy_rrt.planners.checks import check_dof
 
@@ -90,7 +91,7 @@ class Problem:
                    groups=len(scenario.arms))
 
 
-def iterations_for(problems: list[Problem], knots_b: np.ndarray, consts_b: np.ndarray,
+def iterations_for(problems: list[TrainingProblem], knots_b: np.ndarray, consts_b: np.ndarray,
                    bounds_mode: str, seeds: np.ndarray, max_iter: int) -> np.ndarray:
     """Iterations int64[P, S, R] (``-1`` = failed) of P individuals on S problems x R seeds.
 
@@ -157,7 +158,7 @@ def score(iterations: np.ndarray, kind: str, max_iter: int, baseline=None) -> np
     return fitness(iterations, max_iter)
 
 
-def rrt_baseline(problems: list[Problem], seeds: np.ndarray, max_iter: int) -> np.ndarray:
+def rrt_baseline(problems: list[TrainingProblem], seeds: np.ndarray, max_iter: int) -> np.ndarray:
     """RRT's median iterations per problem over *seeds* (failures count as ``max_iter``):
     the reference the log-ratio fitness divides by, computed once per training run."""
     from xfuzzy_rrt.planners.rrt import DEFAULT_GOAL_BIAS, DEFAULT_STEP_DEG, rrt_kernel

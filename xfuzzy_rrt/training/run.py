@@ -250,9 +250,9 @@ def baselines(scenarios: list[TrainingScenario], max_iter: int) -> tuple[float, 
     """RRT's median iterations on each scenario over seeds ``0..BASELINE_RUNS-1``."""
     import numpy as np
 
-    from xfuzzy_rrt.training.evaluate import Problem, rrt_baseline
+    from xfuzzy_rrt.training.evaluate import TrainingProblem, rrt_baseline
 
-    problems = [Problem.from_scenario(t.scenario) for t in scenarios]
+    problems = [TrainingProblem.from_scenario(t.scenario) for t in scenarios]
     return tuple(float(b) for b in rrt_baseline(problems, np.arange(BASELINE_RUNS), max_iter))
 
 
@@ -316,7 +316,7 @@ def run_training(job: TrainJob,
                  on_phase: Callable[[str], None] | None = None) -> TrainResult:
     """Train (or resume), checkpointing every generation; write the rulebook at the end."""
     from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
-    from xfuzzy_rrt.training.evaluate import Problem
+    from xfuzzy_rrt.training.evaluate import TrainingProblem
     from xfuzzy_rrt.training.workers import make_evaluator
 
     job.check_out()
@@ -325,8 +325,8 @@ def run_training(job: TrainJob,
         state = load_checkpoint(job.checkpoint_dir, config)
     else:
         state = new_state(config, [s.rulebook for s in job.seed_rulebooks])
-    problems = [Problem.from_scenario(t.scenario) for t in job.scenarios]
-    held_out = [Problem.from_scenario(t.scenario) for t in job.validation]
+    problems = [TrainingProblem.from_scenario(t.scenario) for t in job.scenarios]
+    held_out = [TrainingProblem.from_scenario(t.scenario) for t in job.validation]
     history_path = job.out / HISTORY_FILE
 
     def checkpoint(row: dict, new) -> None:

@@ -24,20 +24,20 @@ from typing import Callable, Sequence
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.training.evaluate import Problem, iterations_for
+from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for
 from xfuzzy_rrt.training.genome import decode
 
 #: Chunks per worker per generation: enough to balance uneven runs, few enough to be cheap.
 CHUNKS_PER_WORKER = 4
 
-_PROBLEMS: list[Problem] | None = None  # set once per worker process by _init_worker
+_PROBLEMS: list[TrainingProblem] | None = None  # set once per worker process by _init_worker
 #: Seconds to reach a Dask scheduler before giving up.
 CONNECT_TIMEOUT_S = 3.0
 #: prctl(2) option: the signal this process gets when its parent dies (linux/prctl.h).
 PR_SET_PDEATHSIG = 1
 
 
-def evaluate_chunk(genes: np.ndarray, problems: Sequence[Problem], bounds_mode: str,
+def evaluate_chunk(genes: np.ndarray, problems: Sequence[TrainingProblem], bounds_mode: str,
                    seeds: np.ndarray, max_iter: int, dof: int = 2) -> np.ndarray:
     """Iterations int64[n, S, R] of the individuals ``genes`` [n, n_genes] (3,822 at 2 DOF;
     *dof* fixes the genome's outputs and ranges, see :func:`~.genome.decode`)."""
@@ -66,7 +66,7 @@ def die_with_parent(parent_pid: int) -> bool:
     return True
 
 
-def _init_worker(problems: list[Problem], parent_pid: int) -> None:
+def _init_worker(problems: list[TrainingProblem], parent_pid: int) -> None:
     global _PROBLEMS
     die_with_parent(parent_pid)
     _PROBLEMS = problems
@@ -94,7 +94,7 @@ class Evaluator:
     finish (for the CLI's progress display). Use as a context manager to release workers.
     """
 
-    def __init__(self, problems: list[Problem], bounds_mode: str, max_iter: int, dof: int = 2):
+    def __init__(self, problems: list[TrainingProblem], bounds_mode: str, max_iter: int, dof: int = 2):
         self.problems = list(problems)
         self.bounds_mode = bounds_mode
         self.max_iter = int(max_iter)
@@ -215,7 +215,7 @@ class DaskEvaluator(Evaluator):
         self._client.close()
 
 
-def make_evaluator(problems: list[Problem], bounds_mode: str, max_iter: int,
+def make_evaluator(problems: list[TrainingProblem], bounds_mode: str, max_iter: int,
                    workers: int | None = None, scheduler: str | None = None,
                    dof: int = 2) -> Evaluator:
     """The engine the options ask for: Dask with ``scheduler``, else ``workers`` processes

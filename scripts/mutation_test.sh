@@ -5,7 +5,8 @@
 # planners/extend.py, and the path bookkeeping: tree.add_node, tree.extract_path and
 # result.path_cost_deg. Which tests judge: tests/test_safety_bounds.py, test_collision.py and
 # test_kinematics.py, the bound files named after each certified step (test_link_obstacle_bound,
-# test_arm_arm_bound with the head-on two-arm case, test_self_pair_bound with self-collision)
+# test_arm_arm_bound with the head-on two-arm case, test_self_pair_bound with self-collision),
+# test_work_counter
 # and the N-DOF files test_motion_bound_ndof.py and test_exact_geometry_ndof.py (override with
 # MUTATION_TESTS="tests/a.py tests/b.py").
 #
@@ -44,7 +45,7 @@ PY=${PYTHON:-$ROOT/.venv/bin/python}
 MUTMUT=$(dirname "$PY")/mutmut
 JOBS=${MUTATION_JOBS:-1}
 WORK=${1:-$(mktemp -d /tmp/xfuzzy-mutation.XXXXXX)}
-TESTS=${MUTATION_TESTS:-tests/test_safety_bounds.py tests/test_collision.py tests/test_kinematics.py tests/test_link_obstacle_bound.py tests/test_arm_arm_bound.py tests/test_self_pair_bound.py tests/test_motion_bound_ndof.py tests/test_exact_geometry_ndof.py}
+TESTS=${MUTATION_TESTS:-tests/test_safety_bounds.py tests/test_collision.py tests/test_kinematics.py tests/test_link_obstacle_bound.py tests/test_arm_arm_bound.py tests/test_self_pair_bound.py tests/test_work_counter.py tests/test_motion_bound_ndof.py tests/test_exact_geometry_ndof.py}
 MUTANTS=${MUTATION_MUTANTS:-"xfuzzy_rrt.geometry.collision.* xfuzzy_rrt.geometry.kinematics.* xfuzzy_rrt.planners.extend.* xfuzzy_rrt.planners.tree.x_add_node__mutmut_* xfuzzy_rrt.planners.tree.x_extract_path__mutmut_* xfuzzy_rrt.planners.result.x_path_cost_deg__mutmut_*"}
 FILES=(xfuzzy_rrt/geometry/collision.py xfuzzy_rrt/geometry/kinematics.py
        xfuzzy_rrt/planners/extend.py xfuzzy_rrt/planners/tree.py xfuzzy_rrt/planners/result.py)
@@ -131,8 +132,11 @@ PYEOF
       echo "NOT CAUGHT: $named pass with the $variant weakened by $WEAKEN"
       status=1
     else
-      grep -E "^FAILED|passed|failed" weaken-$variant.log | sed -E 's/ - .*//' | cut -c1-160 | head -6
-      echo "caught: $(grep -cE '^FAILED' weaken-$variant.log) failing tests (log: $WORK/weaken-$variant.log)"
+      for f in $named; do
+        n=$(grep -cE "^FAILED $f::" weaken-$variant.log || true)
+        echo "  $f: $n failing, e.g. $(grep -E "^FAILED $f::" weaken-$variant.log | head -1 | sed -E 's/^FAILED [^:]*:://; s/ - .*//')"
+      done
+      echo "caught (log: $WORK/weaken-$variant.log)"
     fi
   done
   exit $status

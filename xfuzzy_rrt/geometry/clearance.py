@@ -97,8 +97,9 @@ def check_endpoints_keep(scenario, clearance_m: float, margin: float, where: str
     for label, q in (("start", a.start_deg), ("goal", a.goal_deg)):
         c = float(clearance_kernel(a.problem(margin), q))
         if not c > margin:
-            raise InputError(where, f"the {label} configuration is {_mm(c)} from an obstacle, "
-                             f"closer than the clearance {_mm(clearance_m)}: no path can keep it")
+            raise InputError(where, f"the {label} configuration is {_mm(c)} from an obstacle "
+                             f"or link, closer than the clearance {_mm(clearance_m)}: no path "
+                             f"can keep it")
 
 
 def _mm(x: float) -> str:

@@ -48,7 +48,6 @@ Choices where the paper is silent or ambiguous (and why):
 
 from __future__ import annotations
 
-import dataclasses
 import time
 
 import numba as nb
@@ -69,7 +68,8 @@ from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
-from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
+from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
+from xfuzzy_rrt.planners.tree import add_node, extract_path, nearest, reset_tree
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
 MIN_STEP_DEG = default("fuzzy-rrt", "min_step_deg")
@@ -266,11 +266,12 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     knots, consts = rb.compiled
     mode = kernel_mode(rb)
     kernel = kernel_for(mode)
-    a = scenario.arrays()
+    a = scenario_arrays(scenario)
     problem = a.problem(margin)
-    tree = make_tree(int(max_iter) + 2, a.limits_deg)
+    tree = empty_tree(int(max_iter) + 2, a.limits_deg)
     groups = fis_groups(rb, scenario)
-    buffers = make_trace(int(max_iter) if trace else 1, a.dof, knots.shape[0], groups)
+    buffers = (make_trace(int(max_iter), a.dof, knots.shape[0], groups) if trace
+               else idle_trace(a.dof, knots.shape[0], groups))
     if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
         meta0 = tree.meta.copy()
         kernel(problem, tree, int(seed), 0, knots, consts, mode, float(min_step_deg),
@@ -284,7 +285,8 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         wall = time.perf_counter() - t0
     n = int(tree.meta[0])
     path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, a.dof))
-    from xfuzzy_rrt.planners.result import certified_result  # certifies the path (found -> success)
+    # certifies the path (found -> success)
+    from xfuzzy_rrt.planners.result import certified_result, replace_result
 
     recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
                 "bounds": rb.bounds_mode, "min_step_deg": float(min_step_deg),
@@ -293,7 +295,8 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         recorded["max_time_s"] = float(params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
     result = certified_result(
-        a, margin, bool(ok), scenario=scenario.name, planner="fuzzy-rrt", seed=int(seed),
+        a, margin, bool(ok), edges_certified=True, scenario=scenario.name, planner="fuzzy-rrt",
+        seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
@@ -304,5 +307,5 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
 
         frame = trace_frame(buffers, int(iterations), tree.nodes[:n], tree.parent[:n], last, rb,
                             float(min_step_deg), groups)
-        result = dataclasses.replace(result, trace=frame)
+        result = replace_result(result, trace=frame)
     return result

@@ -24,7 +24,8 @@ from xfuzzy_rrt.planners.params import default, resolve_params
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
-from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
+from xfuzzy_rrt.planners.prepared import empty_tree, scenario_arrays
+from xfuzzy_rrt.planners.tree import add_node, extract_path, nearest, reset_tree
 
 DEFAULT_STEP_DEG = default("rrt", "step_deg")
 DEFAULT_GOAL_BIAS = default("rrt", "goal_bias")
@@ -74,9 +75,9 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
     params = resolve_params("rrt", max_iter=max_iter, max_time_s=max_time_s,
                             step_deg=step_deg, goal_bias=goal_bias)
     max_iter = params["max_iter"]
-    a = scenario.arrays()
+    a = scenario_arrays(scenario)
     problem = a.problem(margin)
-    tree = make_tree(int(max_iter) + 2, a.limits_deg)
+    tree = empty_tree(int(max_iter) + 2, a.limits_deg)
     args = (float(params["step_deg"]), float(params["goal_bias"]))
     if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
         meta0 = tree.meta.copy()
@@ -95,7 +96,8 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
         recorded["max_time_s"] = float(params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
     return certified_result(
-        a, margin, bool(ok), scenario=scenario.name, planner="rrt", seed=int(seed),
+        a, margin, bool(ok), edges_certified=True, scenario=scenario.name, planner="rrt",
+        seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),

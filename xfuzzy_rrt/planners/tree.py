@@ -71,9 +71,12 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
     ncx = max(1, int(math.ceil((limits_deg[0, 1] - limits_deg[0, 0]) / cell_deg)))
     ncy = max(1, int(math.ceil((limits_deg[1, 1] - limits_deg[1, 0]) / cell_deg)))
     kd = capacity if dof > 2 else 1
+    # ``nodes``, ``parent`` and ``cell_next`` are written before they are read (add_node), so
+    # they are left uninitialised: filling 10,000-entry arrays cost more than a short plan.
     return TreeArrays(
-        np.zeros((capacity, dof), dtype=np.float64), np.full(capacity, -1, dtype=np.int64),
-        np.full(capacity, -1, dtype=np.int64), np.full(ncx * ncy, -1, dtype=np.int64),
+        np.empty((capacity, dof), dtype=np.float64), np.empty(capacity, dtype=np.int64),
+        np.empty(capacity if dof == 2 else 1, dtype=np.int64),
+        np.full(ncx * ncy if dof == 2 else 1, -1, dtype=np.int64),
         np.array([0, ncx, ncy, ncx, ncy, -1, -1, 0], dtype=np.int64),
         np.array([limits_deg[0, 0], limits_deg[1, 0], cell_deg], dtype=np.float64),
         np.zeros(kd, dtype=np.int64), np.zeros(kd, dtype=np.int64),

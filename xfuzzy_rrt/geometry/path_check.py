@@ -127,6 +127,29 @@ def certify_kernel(P, path, margin):
     return certified, first_bad, first_out
 
 
+def _min_clearance(problem, path) -> tuple[float, int, float]:
+    """``(value, segment, s)`` of the exact minimum signed clearance along ``path``."""
+    # one branch and bound for the whole project (geometry/clearance.py; the robustness Monte
+    # Carlo uses it too), here at the certification's tolerance and without the contact refinement
+    from xfuzzy_rrt.geometry.clearance import min_clearance_kernel
+
+    value, seg, s, lower = min_clearance_kernel(problem, path, MIN_CLEARANCE_TOL_M,
+                                                MIN_CLEARANCE_MAX_EVALS, False)
+    value = float(value)
+    if float(lower) < value - MIN_CLEARANCE_TOL_M:
+        value = float(lower)  # budget reached: report the proven bound, never an optimistic one
+    return value, seg, s
+
+
+def path_min_clearance(arrays, path_deg, margin: float = CERT_MARGIN_M) -> tuple[float, float]:
+    """``(min_clearance_m, penetration_m)`` of a path exactly as :func:`certify_path` reports
+    them, without certifying it: what a result computes only when someone asks (the branch and
+    bound costs more than most plans; see ``planners/result.py``)."""
+    path = np.ascontiguousarray(np.asarray(path_deg, dtype=np.float64))
+    value, _seg, _s = _min_clearance(arrays.problem(margin), path)
+    return value, (max(0.0, -value) if math.isfinite(value) else 0.0)
+
+
 def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
     """Certify ``path_deg`` (``[n, dof]`` degrees) in ``arrays`` (a ``ScenarioArrays``) and
     measure its exact minimum clearance.
@@ -142,16 +165,8 @@ def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
         raise InputError("path", f"must be an array of shape [n, {dof}], got {path.shape}")
     if not np.all(np.isfinite(path)):
         raise InputError("path", "contains non-finite angles")
-    # one branch and bound for the whole project (geometry/clearance.py; the robustness Monte
-    # Carlo uses it too), here at the certification's tolerance and without the contact refinement
-    from xfuzzy_rrt.geometry.clearance import min_clearance_kernel
-
     problem = arrays.problem(margin)
-    value, seg, s, lower = min_clearance_kernel(problem, path, MIN_CLEARANCE_TOL_M,
-                                                MIN_CLEARANCE_MAX_EVALS, False)
-    value = float(value)
-    if float(lower) < value - MIN_CLEARANCE_TOL_M:
-        value = float(lower)  # budget reached: report the proven bound, never an optimistic one
+    value, seg, s = _min_clearance(problem, path)
     where: tuple[float, ...] = ()
     if seg >= 0:
         qa = path[seg]

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import Scenario
-from xfuzzy_rrt.planners.result import PlanResult
+from xfuzzy_rrt.planners.result import PlanResult, replace_result
 
 PLANNERS = ("rrt", "fuzzy-rrt")
 TRACE_SUFFIXES = (".parquet", ".csv")
@@ -129,7 +128,7 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
             rulebook = rulebook if rulebook is not None else spec.rulebook_dir
         result = plan_fuzzy_rrt(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
                                 trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
-        return dataclasses.replace(result, planner=spec.label)
+        return replace_result(result, planner=spec.label)
     from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 
     return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, step_deg=step_deg,

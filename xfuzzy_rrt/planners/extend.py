@@ -12,8 +12,9 @@ from __future__ import annotations
 import math
 
 import numba as nb
+import numpy as np
 
-from xfuzzy_rrt.geometry.collision import config_free, edge_free
+from xfuzzy_rrt.geometry.collision import clearance_kernel, edge_free, within_limits
 from xfuzzy_rrt.planners.result import (
     ACCEPTED,
     EDGE_BLOCKED,
@@ -30,6 +31,8 @@ def extend(P, T, near, sample, step, q_near, q_new):
 
     Writes the near and new configurations into ``q_near``/``q_new`` and returns
     ``(outcome, index)``: the index of the last node added (the goal on success) or -1.
+    An added node's clearance goes to ``T.clear`` (the goal-frame kernel reads it as an input
+    instead of measuring it again).
     Distances are Euclidean in joint space (degrees), over every joint of every arm.
     """
     dof = q_near.shape[0]
@@ -49,11 +52,16 @@ def extend(P, T, near, sample, step, q_near, q_new):
     else:
         for j in range(dof):
             q_new[j] = q_near[j] + (sample[j] - q_near[j]) * (step / d)
-    if not config_free(P, q_new, P.margin):
+    # config_free, spelt out so that the node keeps the clearance it was accepted with
+    if not within_limits(P.limits, q_new):
+        return NODE_IN_COLLISION, -1
+    c_new = clearance_kernel(P, q_new)
+    if not c_new > P.margin:
         return NODE_IN_COLLISION, -1
     if not edge_free(P, q_near, q_new, P.margin):
         return EDGE_BLOCKED, -1
     k = add_node(T, q_new, near)
+    T.clear[k] = c_new
     at_goal = True
     g2 = 0.0
     for j in range(dof):
@@ -65,5 +73,6 @@ def extend(P, T, near, sample, step, q_near, q_new):
         return GOAL_REACHED, k
     if math.sqrt(g2) <= step and edge_free(P, q_new, P.goal, P.margin):
         g = add_node(T, P.goal, k)
+        T.clear[g] = np.nan
         return GOAL_REACHED, g
     return ACCEPTED, k

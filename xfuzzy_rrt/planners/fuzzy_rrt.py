@@ -48,7 +48,6 @@ Choices where the paper is silent or ambiguous (and why):
 
 from __future__ import annotations
 
-import dataclasses
 import time
 
 import numba as nb
@@ -60,6 +59,7 @@ from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.collision import direction_and_distance, nearest_obstacle_for_arm
 from xfuzzy_rrt.geometry.kinematics import arm_end_effector
+from xfuzzy_rrt.geometry.problem import Problem
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
 from xfuzzy_rrt.planners.extend import extend
@@ -68,8 +68,9 @@ from xfuzzy_rrt.planners.params import default, resolve_params
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
-from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
-from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
+from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
+from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
+from xfuzzy_rrt.planners.tree import TreeArrays, add_node, extract_path, nearest, reset_tree
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
 MIN_STEP_DEG = default("fuzzy-rrt", "min_step_deg")
@@ -232,6 +233,27 @@ def fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode, min_step,
     return False, max_iter, -1
 
 
+@nb.njit(cache=True, nogil=True)
+def fuzzy_rrt_entry(p, t, seed, max_iter, knots, consts, bounds_mode, min_step, stop, record,
+                    tr):
+    """:func:`fuzzy_rrt_kernel` with the problem, tree and trace bundles as *plain* tuples
+    (typed by numba's fast C path; see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`)."""
+    return fuzzy_rrt_kernel(Problem(*p), TreeArrays(*t), seed, max_iter, knots, consts,
+                            bounds_mode, min_step, stop, record, TraceArrays(*tr))
+
+
+@nb.njit(cache=True, nogil=True)
+def goal_frame_entry(p, t, seed, max_iter, knots, consts, mode, min_step, stop, record, tr):
+    """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, plain tuples as above."""
+    return goal_frame_kernel(Problem(*p), TreeArrays(*t), seed, max_iter, knots, consts, mode,
+                             min_step, stop, record, TraceArrays(*tr))
+
+
+def entry_for(mode: int):
+    """:func:`kernel_for`'s loop, called with plain tuples (what :func:`plan_fuzzy_rrt` uses)."""
+    return goal_frame_entry if mode == GOAL_FRAME else fuzzy_rrt_entry
+
+
 def _resolve_rulebook(rulebook):
     """A loaded rulebook as given, else the (cached) directory or shipped default."""
     from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook_cached
@@ -265,26 +287,28 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     check_rulebook_fits(rb, scenario)
     knots, consts = rb.compiled
     mode = kernel_mode(rb)
-    kernel = kernel_for(mode)
-    a = scenario.arrays()
+    kernel = entry_for(mode)
+    a = scenario_arrays(scenario)
     problem = a.problem(margin)
-    tree = make_tree(int(max_iter) + 2, a.limits_deg)
+    tree = empty_tree(int(max_iter) + 2, a.limits_deg)
     groups = fis_groups(rb, scenario)
-    buffers = make_trace(int(max_iter) if trace else 1, a.dof, knots.shape[0], groups)
+    buffers = (make_trace(int(max_iter), a.dof, knots.shape[0], groups) if trace
+               else idle_trace(a.dof, knots.shape[0], groups))
     if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
         meta0 = tree.meta.copy()
-        kernel(problem, tree, int(seed), 0, knots, consts, mode, float(min_step_deg),
-               np.zeros(1, dtype=np.int64), bool(trace), buffers)
+        kernel(tuple(problem), tuple(tree), int(seed), 0, knots, consts, mode,
+               float(min_step_deg), np.zeros(1, dtype=np.int64), bool(trace), tuple(buffers))
         reset_tree(tree, meta0)
     with StopFlag(max_time_s) as flag:
         t0 = time.perf_counter()
-        ok, iterations, last = kernel(problem, tree, int(seed), int(max_iter), knots, consts,
-                                      mode, float(min_step_deg), flag.array, bool(trace),
-                                      buffers)
+        ok, iterations, last = kernel(tuple(problem), tuple(tree), int(seed), int(max_iter),
+                                      knots, consts, mode, float(min_step_deg), flag.array,
+                                      bool(trace), tuple(buffers))
         wall = time.perf_counter() - t0
     n = int(tree.meta[0])
     path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, a.dof))
-    from xfuzzy_rrt.planners.result import certified_result  # certifies the path (found -> success)
+    # certifies the path (found -> success)
+    from xfuzzy_rrt.planners.result import certified_result, replace_result
 
     recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
                 "bounds": rb.bounds_mode, "min_step_deg": float(min_step_deg),
@@ -293,7 +317,8 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         recorded["max_time_s"] = float(params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
     result = certified_result(
-        a, margin, bool(ok), scenario=scenario.name, planner="fuzzy-rrt", seed=int(seed),
+        a, margin, bool(ok), edges_certified=True, scenario=scenario.name, planner="fuzzy-rrt",
+        seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
@@ -304,5 +329,5 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
 
         frame = trace_frame(buffers, int(iterations), tree.nodes[:n], tree.parent[:n], last, rb,
                             float(min_step_deg), groups)
-        result = dataclasses.replace(result, trace=frame)
+        result = replace_result(result, trace=frame)
     return result

@@ -127,6 +127,8 @@ def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step
     has_obstacles = P.obstacles.shape[0] > 0 or P.arm_first.shape[0] > 2
 
     add_node(T, P.start, -1)
+    if has_obstacles:
+        T.clear[0] = clearance_kernel(P, T.nodes[0])
     current = 0
     best = _joint_dist(P.start, goal)
     stagnation = 0.0
@@ -138,7 +140,7 @@ def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step
         q = T.nodes[current]
         d_goal = _joint_dist(q, goal)
         if has_obstacles:
-            c = clearance_kernel(P, q)
+            c = T.clear[current]  # measured when the node was accepted (extend)
             c_deg = max(c, 0.0) * deg_per_m
         else:
             c_deg = clear_top

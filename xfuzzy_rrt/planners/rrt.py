@@ -17,6 +17,7 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.geometry.clearance import planning_margin
+from xfuzzy_rrt.geometry.problem import Problem
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
 from xfuzzy_rrt.planners.extend import extend
@@ -24,7 +25,8 @@ from xfuzzy_rrt.planners.params import default, resolve_params
 from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, path_cost_deg
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
-from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
+from xfuzzy_rrt.planners.prepared import empty_tree, scenario_arrays
+from xfuzzy_rrt.planners.tree import TreeArrays, add_node, extract_path, nearest, reset_tree
 
 DEFAULT_STEP_DEG = default("rrt", "step_deg")
 DEFAULT_GOAL_BIAS = default("rrt", "goal_bias")
@@ -58,6 +60,17 @@ def rrt_kernel(P, T, seed, max_iter, step, goal_bias, stop):
     return False, max_iter, -1
 
 
+@nb.njit(cache=True, nogil=True)
+def rrt_entry(p, t, seed, max_iter, step, goal_bias, stop):
+    """:func:`rrt_kernel` called with the problem and the tree as *plain* tuples.
+
+    Why: numba types a named-tuple argument in Python, element by element, on every call
+    (20-40 us for our two bundles, as much as a short 2-DOF plan); a plain tuple of arrays is
+    typed by its fast C path. The bundles are rebuilt here, inside compiled code, for free.
+    """
+    return rrt_kernel(Problem(*p), TreeArrays(*t), seed, max_iter, step, goal_bias, stop)
+
+
 def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER,
              step_deg: float = DEFAULT_STEP_DEG, goal_bias: float = DEFAULT_GOAL_BIAS,
              margin: float | None = None, clearance_m: float | None = None,
@@ -74,17 +87,18 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
     params = resolve_params("rrt", max_iter=max_iter, max_time_s=max_time_s,
                             step_deg=step_deg, goal_bias=goal_bias)
     max_iter = params["max_iter"]
-    a = scenario.arrays()
+    a = scenario_arrays(scenario)
     problem = a.problem(margin)
-    tree = make_tree(int(max_iter) + 2, a.limits_deg)
+    tree = empty_tree(int(max_iter) + 2, a.limits_deg)
     args = (float(params["step_deg"]), float(params["goal_bias"]))
     if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
         meta0 = tree.meta.copy()
-        rrt_kernel(problem, tree, int(seed), 0, *args, np.zeros(1, dtype=np.int64))
+        rrt_entry(tuple(problem), tuple(tree), int(seed), 0, *args, np.zeros(1, dtype=np.int64))
         reset_tree(tree, meta0)
     with StopFlag(max_time_s) as flag:
         t0 = time.perf_counter()
-        ok, iterations, last = rrt_kernel(problem, tree, int(seed), int(max_iter), *args,
+        ok, iterations, last = rrt_entry(tuple(problem), tuple(tree), int(seed), int(max_iter),
+                                         *args,
                                           flag.array)
         wall = time.perf_counter() - t0
     n = int(tree.meta[0])
@@ -95,7 +109,8 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
         recorded["max_time_s"] = float(params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
     return certified_result(
-        a, margin, bool(ok), scenario=scenario.name, planner="rrt", seed=int(seed),
+        a, margin, bool(ok), edges_certified=True, scenario=scenario.name, planner="rrt",
+        seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),

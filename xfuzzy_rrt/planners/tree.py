@@ -4,24 +4,31 @@ Nodes live in preallocated arrays (``nodes[cap, dof]`` in degrees, ``parent[cap]
 compiled planner loop never allocates. Nearest-neighbour search is *exact* (the brute-force
 answer, ties to the lowest node index) and must not make long runs quadratic.
 
+- **Small trees: a linear scan.** Below a measured size (``BRUTE_MAX_2D``, ``BRUTE_MAX_KD``;
+  ``benchmarks/nn_scaling.py``) scanning every node beats any structure's bookkeeping.
 - **Two joints: a uniform grid** with one linked list per cell, searched in Chebyshev rings
   around the query's cell and only within the bounding box of occupied cells. A ring search
   stops once the best distance found is strictly below the smallest distance any unvisited ring
   could hold, so the cost per query stays roughly constant as the tree grows to 10,000 nodes.
 - **Three joints and more: a balanced k-d tree plus a small buffer.** The nodes added since the
   last build sit in a buffer scanned linearly; when it outgrows ``max(32, 2 sqrt(n))`` the
-  k-d tree is rebuilt over all nodes by median splits (quickselect, split axis = depth mod N),
-  so it is balanced whatever order the nodes came in. An *incremental* k-d tree was measured
-  slower than a linear scan: an RRT adds nodes in a spatially correlated order and the tree
-  degenerates into a chain. A query descends the k-d tree depth first and visits the far side of
-  a split only when the split plane is not farther than the best distance found (``<=``: equal
-  distances must be seen for the lowest-index tie rule), then scans the buffer. Rebuilds cost
-  ``O(n log n)`` about ``sqrt(n) / 2`` times per run; a query costs the tree search plus at most
-  ``2 sqrt(n)`` distances.
+  k-d tree is rebuilt over all nodes by median splits (quickselect) along each range's widest
+  axis, down to buckets of ``KD_LEAF`` nodes, so it is balanced whatever order the nodes came
+  in. An *incremental* k-d tree was measured slower than a linear scan: an RRT adds nodes in a
+  spatially correlated order and the tree degenerates into a chain. A query descends the k-d
+  tree depth first and visits a far side only when the squared distance from the query to its
+  cell, summed over every axis (not just the split axis: that is what keeps 5-7 joints
+  pruning), is not above the best distance found (``<=``: equal distances must be seen for
+  the lowest-index tie rule), then scans the buffer. Rebuilds cost ``O(n log n)`` about
+  ``sqrt(n) / 2`` times per run; a query costs the tree search plus at most ``2 sqrt(n)``
+  distances. At 7 joints a whole RRT-like run of N nodes costs about N^1.4 distance
+  evaluations (measured, benchmarks/nn_scaling.py), not N^2.
+
+Every distance a query computes adds 1 to ``meta[NN_VISITS]`` (the deterministic work count).
 
 The arrays travel together as one :class:`TreeArrays` record (a numba named tuple). Integer
-grid bookkeeping is ``meta = [n_nodes, ncx, ncy, bx0, by0, bx1, by1]`` (grid size and occupied
-cell bounding box) and the grid geometry ``grid = [lo0, lo1, cell]``.
+grid bookkeeping is ``meta = [n_nodes, ncx, ncy, bx0, by0, bx1, by1, kd_n, nn_visits]`` (grid
+size, occupied cell bounding box, nodes in the k-d tree, distances computed) and the grid geometry ``grid = [lo0, lo1, cell]``.
 """
 
 from __future__ import annotations
@@ -54,10 +61,29 @@ class TreeArrays(NamedTuple):
     kd_axis: np.ndarray
     kd_stack: np.ndarray
     kd_stack_lb: np.ndarray
+    #: per stack entry (and one more row for the range being searched), the query's offset
+    #: from the range's cell along every axis
+    kd_off: np.ndarray
+    #: each node's clearance (m) as measured when it was accepted (NaN where it was not:
+    #: a goal joined by the connection step); planners read it instead of measuring again
+    clear: np.ndarray
 
 
 #: ``meta`` slot holding how many nodes the k-d tree covers (the rest are in the buffer).
 KD_N = 7
+#: ``meta`` slot counting the tree nodes whose distance to a nearest-neighbour query was
+#: computed (the tree's share of the deterministic work count, docs: interfaces item 1).
+NN_VISITS = 8
+#: Trees up to this many nodes answer a query by a linear scan, which beats the grid (two
+#: joints) or the k-d tree there (benchmarks/nn_scaling.py measures the crossover).
+BRUTE_MAX_2D = 128
+#: The same for the k-d tree, by number of joints (3, 4, 5, 6, 7+).
+BRUTE_MAX_KD = (192, 256, 384, 640, 768)
+#: The k-d cell bound is multiplied by this before it may prune (1e-9 below exact: rounding in
+#: the bound can never hide a node as close as the best one).
+KD_SLACK = 1.0 - 1e-9
+#: Largest k-d bucket (a range this small is scanned, not split).
+KD_LEAF = 12
 #: Entries of the k-d search stack: two per level of a balanced tree of 10^6 nodes, and more.
 KD_STACK = 128
 
@@ -71,13 +97,18 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
     ncx = max(1, int(math.ceil((limits_deg[0, 1] - limits_deg[0, 0]) / cell_deg)))
     ncy = max(1, int(math.ceil((limits_deg[1, 1] - limits_deg[1, 0]) / cell_deg)))
     kd = capacity if dof > 2 else 1
+    # ``nodes``, ``parent`` and ``cell_next`` are written before they are read (add_node), so
+    # they are left uninitialised: filling 10,000-entry arrays cost more than a short plan.
     return TreeArrays(
-        np.zeros((capacity, dof), dtype=np.float64), np.full(capacity, -1, dtype=np.int64),
-        np.full(capacity, -1, dtype=np.int64), np.full(ncx * ncy, -1, dtype=np.int64),
-        np.array([0, ncx, ncy, ncx, ncy, -1, -1, 0], dtype=np.int64),
+        np.empty((capacity, dof), dtype=np.float64), np.empty(capacity, dtype=np.int64),
+        np.empty(capacity if dof == 2 else 1, dtype=np.int64),
+        np.full(ncx * ncy if dof == 2 else 1, -1, dtype=np.int64),
+        np.array([0, ncx, ncy, ncx, ncy, -1, -1, 0, 0], dtype=np.int64),
         np.array([limits_deg[0, 0], limits_deg[1, 0], cell_deg], dtype=np.float64),
         np.zeros(kd, dtype=np.int64), np.zeros(kd, dtype=np.int64),
-        np.zeros((KD_STACK, 3), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64))
+        np.zeros((KD_STACK, 3), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64),
+        np.zeros((KD_STACK + 1 if dof > 2 else 1, dof), dtype=np.float64),
+        np.empty(capacity, dtype=np.float64))
 
 
 
@@ -114,15 +145,16 @@ def _grid_add(cell_next, cell_head, meta, grid, i, x, y):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _scan_cell(nodes, cell_next, cell_head, c, q, best_d2, best_i):
+def _scan_cell(nodes, cell_next, cell_head, c, q, best_d2, best_i, visits):
     i = cell_head[c]
     while i >= 0:
         d2 = _d2(nodes, i, q)
+        visits += 1
         if d2 < best_d2 or (d2 == best_d2 and i < best_i):
             best_d2 = d2
             best_i = i
         i = cell_next[i]
-    return best_d2, best_i
+    return best_d2, best_i, visits
 
 
 @nb.njit(cache=True, nogil=True)
@@ -143,6 +175,7 @@ def _grid_nearest(nodes, cell_next, cell_head, meta, grid, q):
     r_max = max(cx - bx0, bx1 - cx, cy - by0, by1 - cy)
     best_d2 = np.inf
     best_i = -1
+    visits = 0
     cell = grid[2]
     for r in range(r0, r_max + 1):
         # Any node in ring r + 1 or beyond is at least r cells away.
@@ -157,8 +190,9 @@ def _grid_nearest(nodes, cell_next, cell_head, meta, grid, q):
         for xx in (cx - r, cx + r):
             if bx0 <= xx <= bx1:
                 for yy in range(y_lo, y_hi + 1):
-                    best_d2, best_i = _scan_cell(nodes, cell_next, cell_head, yy * ncx + xx,
-                                                 q, best_d2, best_i)
+                    best_d2, best_i, visits = _scan_cell(nodes, cell_next, cell_head,
+                                                         yy * ncx + xx, q, best_d2, best_i,
+                                                         visits)
             if r == 0:
                 break
         if r > 0:
@@ -167,13 +201,19 @@ def _grid_nearest(nodes, cell_next, cell_head, meta, grid, q):
             for yy in (cy - r, cy + r):
                 if by0 <= yy <= by1:
                     for xx in range(x_lo, x_hi + 1):
-                        best_d2, best_i = _scan_cell(nodes, cell_next, cell_head,
-                                                     yy * ncx + xx, q, best_d2, best_i)
+                        best_d2, best_i, visits = _scan_cell(nodes, cell_next, cell_head,
+                                                             yy * ncx + xx, q, best_d2, best_i,
+                                                             visits)
+    meta[NN_VISITS] += visits
     return best_i
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _d2(nodes, i, q):
+    if q.shape[0] == 2:  # the same sum, unrolled (0.0 + a == a for a >= 0)
+        dx = nodes[i, 0] - q[0]
+        dy = nodes[i, 1] - q[1]
+        return dx * dx + dy * dy
     d2 = 0.0
     for j in range(q.shape[0]):
         dj = nodes[i, j] - q[j]
@@ -211,7 +251,8 @@ def _select(nodes, perm, lo, hi, k, axis):
 
 @nb.njit(cache=True, nogil=True)
 def _kd_build(T, n):
-    """Balanced k-d tree over nodes ``0 .. n-1`` (median splits, axis = depth mod dof)."""
+    """Balanced k-d tree over nodes ``0 .. n-1``: median splits along the range's widest axis,
+    down to buckets of at most ``KD_LEAF`` nodes."""
     dof = T.nodes.shape[1]
     for i in range(n):
         T.kd_perm[i] = i
@@ -225,10 +266,24 @@ def _kd_build(T, n):
         lo = stack[top, 0]
         hi = stack[top, 1]
         d = stack[top, 2]
-        if hi - lo <= 0:
-            continue
+        if hi - lo <= KD_LEAF:
+            continue  # a bucket: scanned linearly by the query
         mid = (lo + hi) // 2
-        axis = d % dof
+        # split the widest extent (median of that axis): cells stay compact in any dimension
+        axis = 0
+        widest = -1.0
+        for j in range(dof):
+            a_min = np.inf
+            a_max = -np.inf
+            for k in range(lo, hi):
+                v = T.nodes[T.kd_perm[k], j]
+                if v < a_min:
+                    a_min = v
+                if v > a_max:
+                    a_max = v
+            if a_max - a_min > widest:
+                widest = a_max - a_min
+                axis = j
         _select(T.nodes, T.kd_perm, lo, hi, mid, axis)
         T.kd_axis[mid] = axis
         if mid + 1 < hi:
@@ -246,53 +301,87 @@ def _kd_build(T, n):
 
 @nb.njit(cache=True, nogil=True)
 def _kd_nearest(T, q):
-    """Exact nearest node: k-d tree search, then the buffer (lowest index on ties)."""
+    """Exact nearest node: k-d tree search, then the buffer (lowest index on ties).
+
+    A range is skipped when a lower bound of the squared distance from ``q`` to its cell
+    exceeds the best found: the sum over axes of the squared offset from ``q`` to the cell
+    (Arya and Mount's incremental distance), which in 5-7 joints prunes far more than the largest
+    single-axis offset. The bound is relaxed by ``KD_SLACK`` so that rounding (the bound and
+    a node's distance sum their terms in different orders) can never prune a node as close as
+    the best: only the speed depends on the bound, never the answer.
+    """
     nodes = T.nodes
+    dof = q.shape[0]
     best_d2 = np.inf
     best_i = -1
+    visits = 0
     n_kd = T.meta[KD_N]
     stack = T.kd_stack
     lbs = T.kd_stack_lb
+    off = T.kd_off
+    cur = KD_STACK  # the row of ``off`` holding the current range's offsets
     top = 0
     if n_kd > 0:
         stack[0, 0] = 0
         stack[0, 1] = n_kd
         lbs[0] = 0.0
+        for j in range(dof):
+            off[0, j] = 0.0
         top = 1
     while top > 0:
         top -= 1
         lo = stack[top, 0]
         hi = stack[top, 1]
         lb = lbs[top]
-        while lo < hi and lb <= best_d2:
+        if lb * KD_SLACK > best_d2:
+            continue
+        for j in range(dof):
+            off[cur, j] = off[top, j]
+        while lo < hi and lb * KD_SLACK <= best_d2:
+            if hi - lo <= KD_LEAF:
+                for k in range(lo, hi):
+                    i = T.kd_perm[k]
+                    d2 = _d2(nodes, i, q)
+                    if d2 < best_d2 or (d2 == best_d2 and i < best_i):
+                        best_d2 = d2
+                        best_i = i
+                visits += hi - lo
+                break
             mid = (lo + hi) // 2
             i = T.kd_perm[mid]
             d2 = _d2(nodes, i, q)
+            visits += 1
             if d2 < best_d2 or (d2 == best_d2 and i < best_i):
                 best_d2 = d2
                 best_i = i
             axis = T.kd_axis[mid]
             diff = q[axis] - nodes[i, axis]
-            far_lb = max(lb, diff * diff)
-            if diff < 0.0:  # near side: the left range [lo, mid); far: (mid, hi)
-                if mid + 1 < hi and far_lb <= best_d2:
+            old = off[cur, axis]
+            far_lb = lb - old * old + diff * diff
+            if far_lb * KD_SLACK <= best_d2 and ((diff < 0.0 and mid + 1 < hi) or
+                                                 (diff >= 0.0 and lo < mid)):
+                if diff < 0.0:  # near side: the left range [lo, mid); far: (mid, hi)
                     stack[top, 0] = mid + 1
                     stack[top, 1] = hi
-                    lbs[top] = far_lb
-                    top += 1
-                hi = mid
-            else:
-                if lo < mid and far_lb <= best_d2:
+                else:
                     stack[top, 0] = lo
                     stack[top, 1] = mid
-                    lbs[top] = far_lb
-                    top += 1
+                for j in range(dof):
+                    off[top, j] = off[cur, j]
+                off[top, axis] = diff
+                lbs[top] = far_lb
+                top += 1
+            if diff < 0.0:
+                hi = mid
+            else:
                 lo = mid + 1
-    for i in range(n_kd, T.meta[N_NODES]):
+    n = T.meta[N_NODES]
+    for i in range(n_kd, n):
         d2 = _d2(nodes, i, q)
         if d2 < best_d2 or (d2 == best_d2 and i < best_i):
             best_d2 = d2
             best_i = i
+    T.meta[NN_VISITS] += visits + (n - n_kd)
     return best_i
 
 
@@ -304,17 +393,44 @@ def add_node(T, q, parent_index):
         T.nodes[i, j] = q[j]
     T.parent[i] = parent_index
     T.meta[N_NODES] = i + 1
-    if T.nodes.shape[1] == 2:
+    dof = T.nodes.shape[1]
+    if dof == 2:
         _grid_add(T.cell_next, T.cell_head, T.meta, T.grid, i, q[0], q[1])
-    elif (i + 1 - T.meta[KD_N]) > max(32.0, 2.0 * math.sqrt(i + 1.0)):
+    elif i + 1 > _brute_max(dof) and (i + 1 - T.meta[KD_N]) > max(32.0, 2.0 * math.sqrt(i + 1.0)):
         _kd_build(T, i + 1)
     return i
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _brute_max(dof):
+    if dof == 2:
+        return BRUTE_MAX_2D
+    return BRUTE_MAX_KD[min(dof, 7) - 3]
+
+
+@nb.njit(cache=True, nogil=True)
+def _scan_all(T, q):
+    """Linear scan of every node (lowest index on ties: only a strictly smaller distance
+    replaces the best)."""
+    n = T.meta[N_NODES]
+    best_d2 = np.inf
+    best_i = -1
+    for i in range(n):
+        d2 = _d2(T.nodes, i, q)
+        if d2 < best_d2:
+            best_d2 = d2
+            best_i = i
+    T.meta[NN_VISITS] += n
+    return best_i
 
 
 @nb.njit(cache=True, nogil=True)
 def nearest(T, q):
     """Index of the node nearest to ``q`` (Euclidean, degrees); lowest index on ties."""
-    if T.nodes.shape[1] == 2:
+    dof = T.nodes.shape[1]
+    if T.meta[N_NODES] <= _brute_max(dof):
+        return _scan_all(T, q)
+    if dof == 2:
         return _grid_nearest(T.nodes, T.cell_next, T.cell_head, T.meta, T.grid, q)
     return _kd_nearest(T, q)
 

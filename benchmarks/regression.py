@@ -1,0 +1,131 @@
+"""2-DOF kernel time now against a pinned earlier commit, in one run, as a ratio.
+
+Why: golden files pin results, nothing pinned speed, and the N-DOF core change made 2-DOF
+kernels 1.4-2.1x slower unnoticed (issue 24). Timing two versions in two sessions compares two
+machine loads; this script times both in the same session, interleaved call by call, on the
+same problems and seeds, so load changes hit both alike.
+
+How: the old commit is checked out in a temporary worktree (``git worktree add``) and each
+version runs in its own worker process (``PYTHONPATH`` = its tree, its own shipped rulebooks);
+each worker prints where it imported ``xfuzzy_rrt`` from, and the script refuses to go on if
+that is not the tree it asked for. The measure is the planner's own kernel timer
+(``PlanResult.wall_s``); both versions must need the same iterations (same seeds, same
+results), else the line is flagged. Printed: per planner and problem the median kernel time of
+both and their ratio, then the geometric mean of the ratios per planner.
+
+    nice python benchmarks/regression.py                       # 8782882, paper-reference + 12
+    nice python benchmarks/regression.py --problems /tmp/eval9100 --count 24 --seeds 10
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+BASELINE = "8782882"
+PLANNERS = ("rrt", "fuzzy-rrt")
+
+WORKER = r"""
+import json, sys
+import xfuzzy_rrt
+from xfuzzy_rrt.geometry.scenario import load_scenario
+from xfuzzy_rrt.planners.api import plan_scenario
+print(json.dumps({"file": xfuzzy_rrt.__file__}), flush=True)
+cache = {}
+for line in sys.stdin:
+    job = json.loads(line)
+    s = cache.get(job["scenario"]) or cache.setdefault(job["scenario"], load_scenario(job["scenario"]))
+    walls = []
+    for _ in range(job["repeat"]):
+        r = plan_scenario(s, job["planner"], seed=job["seed"])
+        walls.append(r.wall_s)
+    print(json.dumps({"wall": min(walls), "iterations": r.iterations,
+                      "success": bool(r.success)}), flush=True)
+"""
+
+
+class Worker:
+    def __init__(self, tree: Path):
+        env = dict(os.environ, PYTHONPATH=str(tree),
+                   XFUZZY_RRT_RULEBOOKS=str(tree / "rulebooks"))
+        self.proc = subprocess.Popen([sys.executable, "-c", WORKER], cwd=str(tree), env=env,
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        hello = json.loads(self.proc.stdout.readline())
+        where = Path(hello["file"]).resolve()
+        if not where.is_relative_to(tree.resolve()):
+            raise SystemExit(f"error: the worker for {tree} imported xfuzzy_rrt from {where}")
+        self.tree = tree
+
+    def run(self, scenario: Path, planner: str, seed: int, repeat: int) -> dict:
+        self.proc.stdin.write(json.dumps({"scenario": str(scenario), "planner": planner,
+                                          "seed": seed, "repeat": repeat}) + "\n")
+        self.proc.stdin.flush()
+        return json.loads(self.proc.stdout.readline())
+
+    def close(self):
+        self.proc.stdin.close()
+        self.proc.wait()
+
+
+def old_tree(commit: str) -> Path:
+    path = Path(f"/tmp/old{commit}")
+    if not (path / "xfuzzy_rrt").is_dir():
+        subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(path), commit],
+                       check=True, stdout=subprocess.DEVNULL)
+    return path
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--commit", default=BASELINE)
+    ap.add_argument("--problems", type=Path, default=Path("/tmp/eval9100"),
+                    help="folder of 2-DOF scenario files (paper-reference is always added)")
+    ap.add_argument("--count", type=int, default=12, help="problems taken from --problems")
+    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--repeat", type=int, default=3, help="runs per call; the minimum counts")
+    ap.add_argument("--planners", default=",".join(PLANNERS))
+    args = ap.parse_args(argv)
+    problems = [REPO / "xfuzzy_rrt" / "data" / "reference" / "paper-reference.toml"]
+    if args.problems.is_dir():
+        problems += sorted(args.problems.glob("*.toml"))[:args.count]
+    old, new = Worker(old_tree(args.commit)), Worker(REPO)
+    print(f"old: {old.tree} ({args.commit}); new: {new.tree}")
+    planners = args.planners.split(",")
+    rows = {}
+    try:
+        for p in planners:  # warm-up: compile or load both versions' kernels
+            for w in (old, new):
+                w.run(problems[0], p, 0, 1)
+        for seed in range(args.seeds):
+            for sc in problems:
+                for p in planners:
+                    pair = (old, new) if seed % 2 == 0 else (new, old)
+                    got = {w.tree: w.run(sc, p, seed, args.repeat) for w in pair}
+                    rows.setdefault((p, sc.stem), []).append((got[old.tree], got[new.tree]))
+    finally:
+        old.close()
+        new.close()
+    print(f"{'planner':<10} {'problem':<16} {'old ms':>8} {'new ms':>8} {'new/old':>8}  iterations")
+    logs = {p: [] for p in planners}
+    for (p, name), pairs in rows.items():
+        o = statistics.median(a["wall"] for a, _ in pairs) * 1e3
+        n = statistics.median(b["wall"] for _, b in pairs) * 1e3
+        same = all(a["iterations"] == b["iterations"] for a, b in pairs)
+        logs[p].append(math.log(n / o))
+        print(f"{p:<10} {name:<16} {o:>8.3f} {n:>8.3f} {n / o:>8.2f}  "
+              f"{'same' if same else 'DIFFERENT'}")
+    for p in planners:
+        print(f"{p}: geometric mean new/old = {math.exp(statistics.fmean(logs[p])):.2f} "
+              f"over {len(logs[p])} problems x {args.seeds} seeds")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

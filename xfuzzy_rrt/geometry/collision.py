@@ -230,11 +230,24 @@ def clearance_kernel(P, q_deg):
             best = min(best, _link_clearance(x, y, nx, ny, P.radii[a], P.obstacles))
             x = nx
             y = ny
+    P.work[0] += P.links.shape[0] * P.obstacles.shape[0]
     if n_arms > 1:
         seg = np.empty((P.links.shape[0], 4))
         link_segments_into(P, q_deg, seg)
         best = min(best, arm_arm_clearance(P, seg))
+        P.work[0] += _arm_pairs(P)
     return best
+
+
+@nb.njit(cache=True, nogil=True)
+def _arm_pairs(P):
+    """Link-link pairs of different arms: the distances one arm-arm clearance evaluates."""
+    total = 0
+    n_arms = P.arm_first.shape[0] - 1
+    for a in range(n_arms):
+        for b in range(a + 1, n_arms):
+            total += (P.arm_first[a + 1] - P.arm_first[a]) * (P.arm_first[b + 1] - P.arm_first[b])
+    return total
 
 
 @nb.njit(cache=True, nogil=True)
@@ -300,8 +313,11 @@ def edge_free(P, qa_deg, qb_deg, margin):
         first = P.arm_first[a]
         for k in range(first, P.arm_first[a + 1]):
             mks[k] = link_motion_bound(P.links, qa_deg, qb_deg, k, first)
+    # Distances evaluated per stop (the work counter, geometry/problem.py).
+    per_stop = (P.links.shape[0] * obstacles.shape[0]) + (_arm_pairs(P) if n_arms > 1 else 0)
     s = 0.0
     while True:
+        P.work[0] += per_stop
         # Per-link clearance at q(s) and the safe advance it buys.
         cmin = np.inf
         ds = np.inf

@@ -15,6 +15,11 @@ Fields (all float64 unless said):
 - ``limits[L, 2]``, ``start[L]``, ``goal[L]``: joint limits and configurations in degrees.
 - ``margin``: the clearance (m) configurations must keep, with the user clearance folded in
   (:func:`~xfuzzy_rrt.geometry.collision.effective_margin`).
+- ``clearance``: the surgeon's clearance (m) alone, ``margin`` less the certification slack.
+- ``work[1]`` (int64): the deterministic work counter -- every exact element distance the
+  collision kernels evaluate adds 1 (one per link-obstacle pair, per link-link pair of two
+  arms). Fresh and zeroed for every bundle :meth:`ScenarioArrays.problem` makes, so a plan's
+  count starts at 0; counting never changes a result.
 
 A single-arm problem has ``A = 1`` and every loop over arms runs once, so its arithmetic is the
 one of the single-arm code it replaced, operation for operation (the golden files pin it).
@@ -38,6 +43,8 @@ class Problem(NamedTuple):
     start: np.ndarray
     goal: np.ndarray
     margin: float
+    clearance: float
+    work: np.ndarray
 
 
 def single_arm_problem(links, base, radius, obstacles, limits, start=None, goal=None,
@@ -51,11 +58,20 @@ def single_arm_problem(links, base, radius, obstacles, limits, start=None, goal=
     return Problem(links, np.array([0, n], dtype=np.int64),
                    np.ascontiguousarray(base, dtype=np.float64).reshape(1, 2),
                    np.array([float(radius)]), np.ascontiguousarray(obstacles, dtype=np.float64).reshape(-1, 5),
-                   limits, start, goal, float(margin))
+                   limits, start, goal, float(margin), _clearance_of(float(margin)),
+                   np.zeros(1, dtype=np.int64))
+
+
+def _clearance_of(margin: float) -> float:
+    """The user clearance folded into a kernel ``margin`` (0 for margins at or below the
+    certification slack)."""
+    from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
+
+    return max(0.0, margin - CERT_MARGIN_M)
 
 
 @nb.njit(cache=True, nogil=True)
 def with_obstacles(P, obstacles):
     """``P`` with other obstacles (the robustness analysis moves and grows them per trial)."""
     return Problem(P.links, P.arm_first, P.bases, P.radii, obstacles, P.limits, P.start, P.goal,
-                   P.margin)
+                   P.margin, P.clearance, P.work)

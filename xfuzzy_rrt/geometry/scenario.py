@@ -177,10 +177,11 @@ class ScenarioArrays:
 
     def problem(self, margin: float):
         """The compiled problem bundle every kernel takes (:class:`~xfuzzy_rrt.geometry.problem.Problem`)."""
-        from xfuzzy_rrt.geometry.problem import Problem
+        from xfuzzy_rrt.geometry.problem import Problem, _clearance_of
 
         return Problem(self.links, self.arm_first, self.bases, self.radii, self.obstacles,
-                       self.limits_deg, self.start_deg, self.goal_deg, float(margin))
+                       self.limits_deg, self.start_deg, self.goal_deg, float(margin),
+                       _clearance_of(float(margin)), np.zeros(1, dtype=np.int64))
 
 
 # --------------------------------------------------------------------------------------------

@@ -11,6 +11,13 @@ it); ``success`` is derived, ``found and certified``, so no result can call a co
 success. ``min_clearance_m`` is the exact smallest signed distance between any link capsule
 and any obstacle along the path (negative: penetration depth; ``None`` without a path, ``inf``
 without obstacles -- ``null`` in JSON either way). Planners build results through :func:`certified_result`.
+
+``work`` is the deterministic work count of the planning (not of the final certification), in
+*distance evaluations*: every exact link-obstacle and link-link distance the collision kernels
+evaluated (``Problem.work``) plus every tree node whose distance to a nearest-neighbour query
+was computed (``TreeArrays.meta[NN_VISITS]``). Same seed, same count, on any machine and with
+any number of workers, so it compares planners where wall-clock time is noisy. ``None`` for a
+planner that does not count (OMPL's, until its bridge counts).
 """
 
 from __future__ import annotations
@@ -68,6 +75,8 @@ class PlanResult:
     #: Why a found path is not certified (one sentence naming the segment, configuration and
     #: depth); ``None`` when certified or when nothing was found.
     violation: str | None = None
+    #: Deterministic work count (module docstring); ``None`` when the planner does not count.
+    work: int | None = None
 
     def __post_init__(self) -> None:
         if self.certified and not self.found:
@@ -96,6 +105,7 @@ class PlanResult:
             "min_clearance_m": _finite_or_none(self.min_clearance_m),
             "penetration_m": _finite_or_none(self.penetration_m),
             "wall_s": float(self.wall_s),
+            "work": None if self.work is None else int(self.work),
             "path_deg": [[float(a) for a in row] for row in self.path_deg],
             "params": dict(self.params),
         }

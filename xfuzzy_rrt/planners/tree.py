@@ -58,6 +58,9 @@ class TreeArrays(NamedTuple):
 
 #: ``meta`` slot holding how many nodes the k-d tree covers (the rest are in the buffer).
 KD_N = 7
+#: ``meta`` slot counting nearest-neighbour node visits: every tree node whose distance to a
+#: query is computed adds 1 (part of the deterministic work count, ``PlanResult.work``).
+NN_VISITS = 8
 #: Entries of the k-d search stack: two per level of a balanced tree of 10^6 nodes, and more.
 KD_STACK = 128
 
@@ -74,7 +77,7 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
     return TreeArrays(
         np.zeros((capacity, dof), dtype=np.float64), np.full(capacity, -1, dtype=np.int64),
         np.full(capacity, -1, dtype=np.int64), np.full(ncx * ncy, -1, dtype=np.int64),
-        np.array([0, ncx, ncy, ncx, ncy, -1, -1, 0], dtype=np.int64),
+        np.array([0, ncx, ncy, ncx, ncy, -1, -1, 0, 0], dtype=np.int64),
         np.array([limits_deg[0, 0], limits_deg[1, 0], cell_deg], dtype=np.float64),
         np.zeros(kd, dtype=np.int64), np.zeros(kd, dtype=np.int64),
         np.zeros((KD_STACK, 3), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64))
@@ -114,9 +117,10 @@ def _grid_add(cell_next, cell_head, meta, grid, i, x, y):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _scan_cell(nodes, cell_next, cell_head, c, q, best_d2, best_i):
+def _scan_cell(nodes, cell_next, cell_head, c, q, best_d2, best_i, meta):
     i = cell_head[c]
     while i >= 0:
+        meta[NN_VISITS] += 1
         d2 = _d2(nodes, i, q)
         if d2 < best_d2 or (d2 == best_d2 and i < best_i):
             best_d2 = d2
@@ -158,7 +162,7 @@ def _grid_nearest(nodes, cell_next, cell_head, meta, grid, q):
             if bx0 <= xx <= bx1:
                 for yy in range(y_lo, y_hi + 1):
                     best_d2, best_i = _scan_cell(nodes, cell_next, cell_head, yy * ncx + xx,
-                                                 q, best_d2, best_i)
+                                                 q, best_d2, best_i, meta)
             if r == 0:
                 break
         if r > 0:
@@ -168,7 +172,7 @@ def _grid_nearest(nodes, cell_next, cell_head, meta, grid, q):
                 if by0 <= yy <= by1:
                     for xx in range(x_lo, x_hi + 1):
                         best_d2, best_i = _scan_cell(nodes, cell_next, cell_head,
-                                                     yy * ncx + xx, q, best_d2, best_i)
+                                                     yy * ncx + xx, q, best_d2, best_i, meta)
     return best_i
 
 
@@ -267,6 +271,7 @@ def _kd_nearest(T, q):
         while lo < hi and lb <= best_d2:
             mid = (lo + hi) // 2
             i = T.kd_perm[mid]
+            T.meta[NN_VISITS] += 1
             d2 = _d2(nodes, i, q)
             if d2 < best_d2 or (d2 == best_d2 and i < best_i):
                 best_d2 = d2
@@ -288,6 +293,7 @@ def _kd_nearest(T, q):
                     lbs[top] = far_lb
                     top += 1
                 lo = mid + 1
+    T.meta[NN_VISITS] += T.meta[N_NODES] - n_kd
     for i in range(n_kd, T.meta[N_NODES]):
         d2 = _d2(nodes, i, q)
         if d2 < best_d2 or (d2 == best_d2 and i < best_i):

@@ -77,6 +77,10 @@ class PlanResult:
     violation: str | None = None
     #: Deterministic work count (module docstring); ``None`` when the planner does not count.
     work: int | None = None
+    #: The same count for certifying the returned path (exact minimum clearance and certified
+    #: edge check; 0 without a path): ``work + certify_work`` is the end-to-end work, the
+    #: deterministic stand-in for the time a user waits (the tuner's objective).
+    certify_work: int = 0
 
     def __post_init__(self) -> None:
         if self.certified and not self.found:
@@ -106,6 +110,7 @@ class PlanResult:
             "penetration_m": _finite_or_none(self.penetration_m),
             "wall_s": float(self.wall_s),
             "work": None if self.work is None else int(self.work),
+            "certify_work": int(self.certify_work),
             "path_deg": [[float(a) for a in row] for row in self.path_deg],
             "params": dict(self.params),
         }
@@ -131,4 +136,5 @@ def certified_result(arrays, margin: float, found: bool, **fields: Any) -> PlanR
     return PlanResult(found=True, certified=check.certified,
                       min_clearance_m=float(check.min_clearance_m),
                       penetration_m=float(check.penetration_m),
-                      violation=None if check.certified else check.describe(), **fields)
+                      violation=None if check.certified else check.describe(),
+                      certify_work=int(check.work), **fields)

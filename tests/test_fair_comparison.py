@@ -80,14 +80,16 @@ def test_bench_tables_carry_work_and_end_to_end_time(tmp_path):
     g = runs[(runs["scenario"] == "two-circles") & (runs["planner"] == "rrt")]
     row = summary[(summary["scenario"] == "two-circles") & (summary["planner"] == "rrt")].iloc[0]
     assert row["work_median"] == float(np.median(g["work"]))
+    assert (runs["work_total"] == runs["work"] + runs["certify_work"]).all()
+    assert row["work_total_median"] == float(np.median(g["work_total"]))
     pd.testing.assert_frame_equal(summarise(runs), summary, check_dtype=False)
     ratios = pd.read_csv(tmp_path / "b" / "ratios.csv")
     tuned = ratios[ratios["baseline"] == "rrt:tuned"]
-    assert set(tuned["metric"]) == {"time_total_s", "work"}
+    assert set(tuned["metric"]) == {"time_total_s", "work_total"}
     assert set(tuned["planner"]) == {"rrt", "fuzzy-rrt"}
-    s = summary.set_index(["scenario", "planner"])["work_median"]
+    s = summary.set_index(["scenario", "planner"])["work_total_median"]
     per = [s[(n, "rrt:tuned")] / s[(n, "fuzzy-rrt")] for n in ("two-circles", "boxes-and-circle")]
-    w = tuned[(tuned["planner"] == "fuzzy-rrt") & (tuned["metric"] == "work")].iloc[0]
+    w = tuned[(tuned["planner"] == "fuzzy-rrt") & (tuned["metric"] == "work_total")].iloc[0]
     assert w["ratio_median"] == pytest.approx(np.median(per))
     assert w["ratio_worst"] == pytest.approx(min(per))
     meta = json.loads((tmp_path / "b" / "bench.json").read_text())
@@ -243,10 +245,10 @@ def test_evaluate_without_options_compares_with_the_tuned_rrt(run_cli, tmp_path)
     per = []
     for name in ("two-circles", "boxes-and-circle"):
         g = runs[(runs["scenario"] == name)]
-        med = g.groupby("planner")["work"].median()
+        med = g.groupby("planner")["work_total"].median()
         per.append(med["rrt:tuned"] / med[gf])
-        assert problems.loc[(name, gf), "work_ratio"] == pytest.approx(per[-1])
-    assert summary.loc[gf, "median_work_ratio"] == pytest.approx(np.median(per))
+        assert problems.loc[(name, gf), "work_total_ratio"] == pytest.approx(per[-1])
+    assert summary.loc[gf, "median_work_total_ratio"] == pytest.approx(np.median(per))
     assert summary.loc["rrt:tuned", "median_time_total_ratio"] == 1.0
     assert sorted(summary["time_rank"]) == sorted(
         summary["median_time_total_ratio"].rank(ascending=False, method="min").astype(int))
@@ -270,7 +272,8 @@ def _runs_with_time() -> pd.DataFrame:
             rows.append({"scenario": scen, "planner": planner, "seed": 0, "success": True,
                          "found": True, "certified": True, "iterations": its, "nodes": its,
                          "cost_deg": 100.0, "wall_s": t / 2, "time_first_s": t / 2,
-                         "time_total_s": t, "work": w, "min_clearance_m": 0.004,
+                         "time_total_s": t, "work": w // 2, "certify_work": w - w // 2,
+                         "work_total": w, "min_clearance_m": 0.004,
                          "penetration_m": 0.0})
     return pd.DataFrame(rows)
 
@@ -288,7 +291,7 @@ def test_verdict_ranks_on_end_to_end_time_and_work_against_the_named_tuned_basel
     assert text[1].startswith(
         "Fuzzy-RRT general finds its first certified path 1.2\u00d7 faster than RRT tuned "
         "(step 60\u00b0, goal bias 0.1) end to end on 2 problems (median; it loses on 1, "
-        "worst 0.5\u00d7) and needs 1.2\u00d7 less work (median; worst 0.5\u00d7); "
+        "worst 0.5\u00d7) and needs 1.2\u00d7 less end-to-end work (median; worst 0.5\u00d7); "
         "Fuzzy-RRT general needs 6\u00d7 fewer iterations than RRT on 2 problems (median)")
     assert text[0].startswith("RRT tuned needs 4\u00d7 fewer iterations than RRT on 2 problems")
     assert "RRT finds its first certified path 2.5\u00d7 slower than RRT tuned" in text[-1]

@@ -26,9 +26,11 @@ edge costs more certified stops than a 10° one, so every planner is also ranked
 - *end-to-end time to the first certified path* (``time_total_s``): ``time.perf_counter()``
   around the whole :func:`~xfuzzy_rrt.planners.api.plan_scenario` call, as a user waits for it
   (set-up, planning, certification of the path);
-- *work* (``work``): the planner's deterministic work count (``PlanResult.work``, distance
-  evaluations plus nearest-neighbour visits), identical on any machine; empty for planners
-  that do not count.
+- *end-to-end work* (``work_total``): the planner's deterministic work count
+  (``PlanResult.work``: distance evaluations plus nearest-neighbour visits of the search, also
+  in ``work``) plus that of certifying its path (``certify_work``), identical on any machine;
+  empty for planners that do not count. End to end like the time, and the measure the tuned
+  RRT was tuned on.
 
 A run without a certified path counts with the time and the work it spent until its budget
 ran out (as its iterations count ``max_iter``): the user waited that long for nothing, and the
@@ -49,17 +51,17 @@ import pandas as pd
 
 PROBLEM_COLUMNS = ["scenario", "planner", "runs", "success_rate", "median_iterations",
                    "median_cost_deg", "median_time_s", "iteration_ratio", "cost_ratio",
-                   "time_ratio", "median_time_total_s", "median_work", "time_total_ratio",
-                   "work_ratio"]
+                   "time_ratio", "median_time_total_s", "median_work", "median_work_total",
+                   "time_total_ratio", "work_total_ratio"]
 SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "worst_ratio",
                    "best_ratio", "problems_lost", "worst_success_rate",
                    "problems_success_below_rrt", "median_cost_ratio", "median_time_ratio",
                    "median_time_s", "time_work_baseline", "time_rank", "median_time_total_ratio",
-                   "worst_time_total_ratio", "problems_lost_time", "median_work_ratio",
-                   "worst_work_ratio", "problems_lost_work", "median_time_total_s",
-                   "median_work"]
+                   "worst_time_total_ratio", "problems_lost_time", "median_work_total_ratio",
+                   "worst_work_total_ratio", "problems_lost_work_total", "median_time_total_s",
+                   "median_work", "median_work_total"]
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "cost_deg", "wall_s",
-               "time_total_s", "work"]
+               "time_total_s", "work", "work_total"]
 BASELINE = "rrt"
 TUNED_BASELINE = "rrt:tuned"
 
@@ -85,7 +87,8 @@ def _one(scenario, planner: str, rulebook, seed: int, max_iter: int, clearance_m
     return {"success": ok, "iterations": int(r.iterations) if ok else int(max_iter),
             "cost_deg": float(r.cost_deg) if ok and r.cost_deg is not None else np.nan,
             "wall_s": float(r.wall_s), "time_total_s": total,
-            "work": np.nan if work is None else float(work)}
+            "work": np.nan if work is None else float(work),
+            "work_total": np.nan if work is None else float(work + r.certify_work)}
 
 
 def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs: int = 50,
@@ -112,7 +115,8 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
             if progress:
                 progress(done, total)
     frame = pd.DataFrame(rows, columns=RUN_COLUMNS)
-    frame["work"] = frame["work"].astype("Int64")
+    for col in ("work", "work_total"):
+        frame[col] = frame[col].astype("Int64")
     problems = problem_table(frame, [e[0] for e in entries])
     return ProtocolResult(runs=frame, problems=problems, summary=summary_table(problems))
 
@@ -120,7 +124,7 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
 def problem_table(runs: pd.DataFrame, order: list[str]) -> pd.DataFrame:
     """Per (scenario, planner) medians and ratios to RRT (see the module docstring)."""
     runs = runs.copy()
-    for col in ("time_total_s", "work"):
+    for col in ("time_total_s", "work", "work_total"):
         runs[col] = (pd.to_numeric(runs[col], errors="coerce").astype(float) if col in runs
                      else np.nan)
     g = runs.groupby(["scenario", "planner"], sort=False)
@@ -129,7 +133,8 @@ def problem_table(runs: pd.DataFrame, order: list[str]) -> pd.DataFrame:
                 median_cost_deg=("cost_deg", "median"),
                 median_time_s=("wall_s", "median"),
                 median_time_total_s=("time_total_s", "median"),
-                median_work=("work", "median")).reset_index()
+                median_work=("work", "median"),
+                median_work_total=("work_total", "median")).reset_index()
     rrt = per[per["planner"] == "rrt"].set_index("scenario")
     base_it = per["scenario"].map(rrt["median_iterations"])
     base_cost = per["scenario"].map(rrt["median_cost_deg"])
@@ -141,7 +146,8 @@ def problem_table(runs: pd.DataFrame, order: list[str]) -> pd.DataFrame:
     peer = per[per["planner"] == time_work_baseline(order)].set_index("scenario")
     per["time_total_ratio"] = (per["scenario"].map(peer["median_time_total_s"])
                                / per["median_time_total_s"])
-    per["work_ratio"] = per["scenario"].map(peer["median_work"]) / per["median_work"]
+    per["work_total_ratio"] = (per["scenario"].map(peer["median_work_total"])
+                               / per["median_work_total"])
     per["planner"] = pd.Categorical(per["planner"], categories=order, ordered=True)
     per = per.sort_values(["planner", "scenario"], kind="stable").reset_index(drop=True)
     per["planner"] = per["planner"].astype(str)
@@ -185,13 +191,15 @@ def summary_table(problems: pd.DataFrame) -> pd.DataFrame:
             "median_time_s": float(np.nanmedian(g["median_time_s"])),
         })
         t_med, t_worst, t_lost = _dist(g["time_total_ratio"])
-        w_med, w_worst, w_lost = _dist(g["work_ratio"])
+        w_med, w_worst, w_lost = _dist(g["work_total_ratio"])
         rows[-1].update({
             "time_work_baseline": peer, "median_time_total_ratio": t_med,
             "worst_time_total_ratio": t_worst, "problems_lost_time": t_lost,
-            "median_work_ratio": w_med, "worst_work_ratio": w_worst, "problems_lost_work": w_lost,
+            "median_work_total_ratio": w_med, "worst_work_total_ratio": w_worst,
+            "problems_lost_work_total": w_lost,
             "median_time_total_s": _nanmedian(g["median_time_total_s"]),
             "median_work": _nanmedian(g["median_work"]),
+            "median_work_total": _nanmedian(g["median_work_total"]),
         })
     frame = pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
     # Rank on end-to-end time (1 = the largest median ratio to the baseline); ties share.

@@ -9,7 +9,9 @@ Beside the planner's own ``wall_s`` (the compiled search alone) each row has
 ``time_total_s``, the whole :func:`plan_scenario` call as a user waits for it (set-up, planning
 and the certification of the path), and ``work``, the planner's deterministic work count
 (``PlanResult.work``; empty for a planner that does not count): the same in every run of the
-same seed, whatever the machine or the number of workers.
+same seed, whatever the machine or the number of workers; ``certify_work`` counts the
+certification of the path the same way and ``work_total`` is their sum, the end-to-end work
+(the deterministic twin of ``time_total_s``).
 
 Every returned path -- ours or an OMPL planner's -- is certified by the planner API itself
 (``found``, ``certified``, ``min_clearance_m``, ``penetration_m``; ``success`` is ``found and
@@ -47,7 +49,7 @@ from xfuzzy_rrt.planners.result import PlanResult, path_cost_deg
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "nodes", "cost_deg",
                "wall_s", "time_first_s", "found", "certified", "min_clearance_m",
                "penetration_m", "rulebook", "rulebook_sha256", "time_total_s", "work",
-               "certify_work"]
+               "certify_work", "work_total"]
 #: Shortcutting attempts per path (the OMPL helper's default).
 SHORTCUT_ATTEMPTS = 200
 
@@ -152,6 +154,7 @@ def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
         "rulebook": r.rulebook, "rulebook_sha256": r.rulebook_sha256,
         "time_total_s": time_total, "work": np.nan if r.work is None else int(r.work),
         "certify_work": int(r.certify_work),
+        "work_total": np.nan if r.work is None else int(r.work) + int(r.certify_work),
     }
     if job.shortcut:
         row["cost_short_deg"] = np.nan
@@ -256,7 +259,8 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
     runs_df = pd.DataFrame([row for _, row in outputs], columns=columns)
     for col in ("success", "found", "certified"):
         runs_df[col] = runs_df[col].astype(bool)
-    runs_df["work"] = runs_df["work"].astype("Int64")  # integers; empty when not counted
+    for col in ("work", "work_total"):  # integers; empty when not counted
+        runs_df[col] = runs_df[col].astype("Int64")
     summary = summarise(runs_df)
     by_name = {s.name: s for s in scenarios}
     by_run = {(r.scenario, row["planner"], r.seed): r for r, row in outputs}

@@ -16,7 +16,8 @@ Conventions (the same as ``summary.csv`` / ``ratios.csv``):
   is better; "loses" counts scenarios with a ratio below 1;
 - **time and work as the measure** (issue 23): when ``runs.csv`` has them, every planner is
   also compared on end-to-end time to the first certified path (``time_total_s``, the whole
-  planner call) and on its deterministic work count (``work``), medians over all runs (a
+  planner call) and on its deterministic end-to-end work count (``work_total``: the search's
+  ``work`` plus the certification's ``certify_work``), medians over all runs (a
   failed run counts with what it spent), against the peer at its best -- the tuned RRT
   (``rrt:tuned``) when the benchmark ran it, else RRT. The verdict leads with that
   comparison and names the baseline with its settings; iterations stay the paper's measure,
@@ -32,7 +33,7 @@ BASELINE = "rrt"
 #: The peer at its best (planners/tuned.py): the time and work baseline when it ran.
 TUNED_BASELINE = "rrt:tuned"
 TIME_TOTAL = "time_total_s"
-WORK = "work"
+WORK = "work_total"  # end to end, like the time: the search plus the certification
 
 PLANNER_COLUMNS = ["planner", "label", "metric", "scenarios", "runs", "success_rate",
                    "found_rate", "ratio_median", "ratio_worst", "ratio_best", "ratio_geomean",
@@ -275,8 +276,8 @@ def _time_work_clause(row, problems: str, time_label: str) -> str | None:
     wmed = pd.to_numeric(row.get("work_ratio_median", np.nan), errors="coerce")
     if np.isfinite(wmed):
         wshown = _x(wmed if wmed >= 1 else 1 / wmed)
-        what = ("as much work" if wshown == _x(1.0) else
-                f"{wshown} {'less' if wmed >= 1 else 'more'} work")
+        what = ("as much end-to-end work" if wshown == _x(1.0) else
+                f"{wshown} {'less' if wmed >= 1 else 'more'} end-to-end work")
         text += f" and needs {what} (median; worst {_x(row['work_ratio_worst'])})"
     return text
 

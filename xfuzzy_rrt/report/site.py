@@ -257,8 +257,8 @@ def _planner_table(t: pd.DataFrame) -> str:
               "median cost", "min clearance", "penetrating paths"]
     if timed:
         header[1:1] = [f"end-to-end time vs {tb} (median / worst)",
-                       f"work vs {tb} (median / worst)", "median end-to-end time",
-                       "median work"]
+                       f"end-to-end work vs {tb} (median / worst)", "median end-to-end time",
+                       "median end-to-end work"]
     rows = []
     for r in t.itertuples(index=False):
         base = r.planner == BASELINE

@@ -261,7 +261,8 @@ def test_protocol_ratios_follow_from_its_own_runs_table(tmp_path, run_cli):
     runs = pd.read_csv(tmp_path / "out" / "runs.csv")
     problems = pd.read_csv(tmp_path / "out" / "problems.csv")
     summary = pd.read_csv(tmp_path / "out" / "summary.csv")
-    assert len(runs) == 2 * 2 * 6 and set(runs["seed"]) == set(range(6))
+    # RRT, the tuned RRT (evaluated by default) and the rulebook
+    assert len(runs) == 2 * 3 * 6 and set(runs["seed"]) == set(range(6))
     ratios = []
     for file in SCENARIOS:
         sc = load_scenario(file)

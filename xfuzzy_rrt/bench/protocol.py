@@ -19,6 +19,26 @@ only then summarised, because a handful of hard problems dominate any pooled mea
 
 OMPL planners count iterations differently, so they are ranked on time only (their iteration
 ratio is left empty).
+
+**Time and work as the measure** (issue 23). Iterations are the paper's measure, but a 60°
+edge costs more certified stops than a 10° one, so every planner is also ranked on
+
+- *end-to-end time to the first certified path* (``time_total_s``): ``time.perf_counter()``
+  around the whole :func:`~xfuzzy_rrt.planners.api.plan_scenario` call, as a user waits for it
+  (set-up, planning, certification of the path);
+- *end-to-end work* (``work_total``): the planner's deterministic work count
+  (``PlanResult.work``: distance evaluations plus nearest-neighbour visits of the search, also
+  in ``work``) plus that of certifying its path (``certify_work``), identical on any machine;
+  empty for planners that do not count. End to end like the time, and the measure the tuned
+  RRT was tuned on.
+
+A run without a certified path counts with the time and the work it spent until its budget
+ran out (as its iterations count ``max_iter``): the user waited that long for nothing, and the
+success rate beside it says how often. These ratios are taken against the *peer at its best*,
+the tuned RRT (``rrt:tuned``, shipped tuned file) when it runs -- by default it does -- else
+against RRT; the summary names that baseline (``time_work_baseline``) and ranks planners by
+their median end-to-end time ratio (``time_rank``, 1 = fastest). Iteration ratios stay
+against the paper's RRT (10°, goal bias 0.05).
 """
 
 from __future__ import annotations
@@ -31,11 +51,19 @@ import pandas as pd
 
 PROBLEM_COLUMNS = ["scenario", "planner", "runs", "success_rate", "median_iterations",
                    "median_cost_deg", "median_time_s", "iteration_ratio", "cost_ratio",
-                   "time_ratio"]
+                   "time_ratio", "median_time_total_s", "median_work", "median_work_total",
+                   "time_total_ratio", "work_total_ratio"]
 SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "worst_ratio",
                    "best_ratio", "problems_lost", "worst_success_rate",
                    "problems_success_below_rrt", "median_cost_ratio", "median_time_ratio",
-                   "median_time_s"]
+                   "median_time_s", "time_work_baseline", "time_rank", "median_time_total_ratio",
+                   "worst_time_total_ratio", "problems_lost_time", "median_work_total_ratio",
+                   "worst_work_total_ratio", "problems_lost_work_total", "median_time_total_s",
+                   "median_work", "median_work_total"]
+RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "cost_deg", "wall_s",
+               "time_total_s", "work", "work_total"]
+BASELINE = "rrt"
+TUNED_BASELINE = "rrt:tuned"
 
 
 @dataclass(frozen=True)
@@ -46,20 +74,28 @@ class ProtocolResult:
 
 
 def _one(scenario, planner: str, rulebook, seed: int, max_iter: int, clearance_m) -> dict:
+    import time
+
     from xfuzzy_rrt.planners.api import plan_scenario
 
+    t0 = time.perf_counter()
     r = plan_scenario(scenario, planner=planner, rulebook=rulebook, seed=seed, max_iter=max_iter,
                       clearance_m=clearance_m)
+    total = time.perf_counter() - t0
     ok = bool(getattr(r, "success", False))
+    work = getattr(r, "work", None)
     return {"success": ok, "iterations": int(r.iterations) if ok else int(max_iter),
             "cost_deg": float(r.cost_deg) if ok and r.cost_deg is not None else np.nan,
-            "wall_s": float(r.wall_s)}
+            "wall_s": float(r.wall_s), "time_total_s": total,
+            "work": np.nan if work is None else float(work),
+            "work_total": np.nan if work is None else float(work + r.certify_work)}
 
 
 def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs: int = 50,
                  seed: int = 0, max_iter: int = 10_000, progress=None,
                  clearance_m: float | None = None) -> ProtocolResult:
-    """Run RRT and every ``(label, planner, rulebook)`` of *planners* on every scenario.
+    """Run RRT and every ``(label, planner, rulebook)`` of *planners* on every scenario (put
+    ``("rrt:tuned", "rrt:tuned", None)`` among them to rank against the tuned RRT).
 
     ``clearance_m`` is the certified margin every planner must keep (``None``: each scenario's).
 
@@ -78,19 +114,27 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
             done += 1
             if progress:
                 progress(done, total)
-    frame = pd.DataFrame(rows, columns=["scenario", "planner", "seed", "success", "iterations",
-                                        "cost_deg", "wall_s"])
+    frame = pd.DataFrame(rows, columns=RUN_COLUMNS)
+    for col in ("work", "work_total"):
+        frame[col] = frame[col].astype("Int64")
     problems = problem_table(frame, [e[0] for e in entries])
     return ProtocolResult(runs=frame, problems=problems, summary=summary_table(problems))
 
 
 def problem_table(runs: pd.DataFrame, order: list[str]) -> pd.DataFrame:
     """Per (scenario, planner) medians and ratios to RRT (see the module docstring)."""
+    runs = runs.copy()
+    for col in ("time_total_s", "work", "work_total"):
+        runs[col] = (pd.to_numeric(runs[col], errors="coerce").astype(float) if col in runs
+                     else np.nan)
     g = runs.groupby(["scenario", "planner"], sort=False)
     per = g.agg(runs=("seed", "size"), success_rate=("success", "mean"),
                 median_iterations=("iterations", "median"),
                 median_cost_deg=("cost_deg", "median"),
-                median_time_s=("wall_s", "median")).reset_index()
+                median_time_s=("wall_s", "median"),
+                median_time_total_s=("time_total_s", "median"),
+                median_work=("work", "median"),
+                median_work_total=("work_total", "median")).reset_index()
     rrt = per[per["planner"] == "rrt"].set_index("scenario")
     base_it = per["scenario"].map(rrt["median_iterations"])
     base_cost = per["scenario"].map(rrt["median_cost_deg"])
@@ -99,15 +143,35 @@ def problem_table(runs: pd.DataFrame, order: list[str]) -> pd.DataFrame:
     per["iteration_ratio"] = np.where(is_ompl, np.nan, base_it / per["median_iterations"])
     per["cost_ratio"] = per["median_cost_deg"] / base_cost
     per["time_ratio"] = base_time / per["median_time_s"]
+    peer = per[per["planner"] == time_work_baseline(order)].set_index("scenario")
+    per["time_total_ratio"] = (per["scenario"].map(peer["median_time_total_s"])
+                               / per["median_time_total_s"])
+    per["work_total_ratio"] = (per["scenario"].map(peer["median_work_total"])
+                               / per["median_work_total"])
     per["planner"] = pd.Categorical(per["planner"], categories=order, ordered=True)
     per = per.sort_values(["planner", "scenario"], kind="stable").reset_index(drop=True)
     per["planner"] = per["planner"].astype(str)
     return per[PROBLEM_COLUMNS]
 
 
+def time_work_baseline(planners) -> str:
+    """The baseline of the time and work ratios: the tuned RRT when it ran, else RRT."""
+    return TUNED_BASELINE if TUNED_BASELINE in set(planners) else BASELINE
+
+
+def _dist(values) -> tuple[float, float, int]:
+    """Median, worst (smallest) and number below 1 of finite ratios (NaN, NaN, 0 without)."""
+    r = np.asarray(values, dtype=float)
+    r = r[np.isfinite(r)]
+    if r.size == 0:
+        return np.nan, np.nan, 0
+    return float(np.median(r)), float(r.min()), int((r < 1.0).sum())
+
+
 def summary_table(problems: pd.DataFrame) -> pd.DataFrame:
     """One row per planner (RRT included, whose ratios are 1 by construction)."""
     rows = []
+    peer = time_work_baseline(problems["planner"])
     rrt_success = problems[problems["planner"] == "rrt"].set_index("scenario")["success_rate"]
     for planner, g in problems.groupby("planner", sort=False):
         r = g["iteration_ratio"].to_numpy(dtype=float)
@@ -126,7 +190,28 @@ def summary_table(problems: pd.DataFrame) -> pd.DataFrame:
             "median_time_ratio": float(np.nanmedian(g["time_ratio"])),
             "median_time_s": float(np.nanmedian(g["median_time_s"])),
         })
-    return pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
+        t_med, t_worst, t_lost = _dist(g["time_total_ratio"])
+        w_med, w_worst, w_lost = _dist(g["work_total_ratio"])
+        rows[-1].update({
+            "time_work_baseline": peer, "median_time_total_ratio": t_med,
+            "worst_time_total_ratio": t_worst, "problems_lost_time": t_lost,
+            "median_work_total_ratio": w_med, "worst_work_total_ratio": w_worst,
+            "problems_lost_work_total": w_lost,
+            "median_time_total_s": _nanmedian(g["median_time_total_s"]),
+            "median_work": _nanmedian(g["median_work"]),
+            "median_work_total": _nanmedian(g["median_work_total"]),
+        })
+    frame = pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
+    # Rank on end-to-end time (1 = the largest median ratio to the baseline); ties share.
+    key = frame["median_time_total_ratio"].fillna(-np.inf)
+    frame["time_rank"] = key.rank(ascending=False, method="min").astype(int)
+    return frame
+
+
+def _nanmedian(values) -> float:
+    v = pd.to_numeric(pd.Series(values), errors="coerce").to_numpy(dtype=float)
+    v = v[np.isfinite(v)]
+    return float(np.median(v)) if v.size else np.nan
 
 
 def write_protocol(result: ProtocolResult, out: Path) -> None:

@@ -106,7 +106,7 @@ BENCH_JSON_KEYS: dict[str, tuple[str, ...]] = {
     "git": ("commit", "dirty"),
     "machine": ("hostname", "system", "machine", "cpus"),
     "settings": ("runs", "seed", "max_iter", "planners", "shortcut", "workers", "rulebook",
-                 "rulebook_dir", "rulebook_sha256", "rulebooks"),
+                 "rulebook_dir", "rulebook_sha256", "rulebooks", "tuned"),
     "scenarios": ("name", "file", "sha256", "toml"),
     "rulebook": ("name", "dir", "sha256", "history"),
     "rulebooks": ("planner", "name", "dir", "sha256", "history"),

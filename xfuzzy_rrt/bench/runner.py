@@ -5,6 +5,14 @@ so they can be spread over worker processes: results are collected in job order,
 every column except the wall-clock ones identical whatever the number of workers. Column names
 are the stable ones of SPEC.md (OMPL-style: one typed row per run).
 
+Beside the planner's own ``wall_s`` (the compiled search alone) each row has
+``time_total_s``, the whole :func:`plan_scenario` call as a user waits for it (set-up, planning
+and the certification of the path), and ``work``, the planner's deterministic work count
+(``PlanResult.work``; empty for a planner that does not count): the same in every run of the
+same seed, whatever the machine or the number of workers; ``certify_work`` counts the
+certification of the path the same way and ``work_total`` is their sum, the end-to-end work
+(the deterministic twin of ``time_total_s``).
+
 Every returned path -- ours or an OMPL planner's -- is certified by the planner API itself
 (``found``, ``certified``, ``min_clearance_m``, ``penetration_m``; ``success`` is ``found and
 certified``), and with ``shortcut=True`` a *certified* path is shortened by the same certified
@@ -23,6 +31,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,7 +48,8 @@ from xfuzzy_rrt.planners.result import PlanResult, path_cost_deg
 
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "nodes", "cost_deg",
                "wall_s", "time_first_s", "found", "certified", "min_clearance_m",
-               "penetration_m", "rulebook", "rulebook_sha256"]
+               "penetration_m", "rulebook", "rulebook_sha256", "time_total_s", "work",
+               "certify_work", "work_total"]
 #: Shortcutting attempts per path (the OMPL helper's default).
 SHORTCUT_ATTEMPTS = 200
 
@@ -123,11 +133,13 @@ def load_rulebooks(planners: list[str], rulebook=None) -> tuple[dict[str, Any], 
 
 
 def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
+    t0 = time.perf_counter()  # end to end, as a user waits: set-up, planning, certification
     r = plan_scenario(job.scenario, planner=job.planner, rulebook=job.rulebook, seed=job.seed,
                       max_iter=job.max_iter)
+    time_total = time.perf_counter() - t0
     params = r.params if isinstance(r.params, dict) else {}
     time_first = params.get("time_first_s")
-    first_solution = (job.planner == "rrt" or job.planner.startswith("fuzzy-rrt")
+    first_solution = (job.planner in ("rrt", "rrt:tuned") or job.planner.startswith("fuzzy-rrt")
                       or params.get("stopped_by") == "solution")
     if time_first is None and r.found and first_solution:
         time_first = r.wall_s  # the run stopped at its first solution
@@ -140,6 +152,9 @@ def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
         "min_clearance_m": np.nan if r.min_clearance_m is None else float(r.min_clearance_m),
         "penetration_m": np.nan if r.penetration_m is None else float(r.penetration_m),
         "rulebook": r.rulebook, "rulebook_sha256": r.rulebook_sha256,
+        "time_total_s": time_total, "work": np.nan if r.work is None else int(r.work),
+        "certify_work": int(r.certify_work),
+        "work_total": np.nan if r.work is None else int(r.work) + int(r.certify_work),
     }
     if job.shortcut:
         row["cost_short_deg"] = np.nan
@@ -244,6 +259,8 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
     runs_df = pd.DataFrame([row for _, row in outputs], columns=columns)
     for col in ("success", "found", "certified"):
         runs_df[col] = runs_df[col].astype(bool)
+    for col in ("work", "work_total"):  # integers; empty when not counted
+        runs_df[col] = runs_df[col].astype("Int64")
     summary = summarise(runs_df)
     by_name = {s.name: s for s in scenarios}
     by_run = {(r.scenario, row["planner"], r.seed): r for r, row in outputs}
@@ -276,6 +293,10 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
                 "rulebook_sha256": getattr(main_rb, "sha256", None),
                 "rulebooks": [{"planner": label, "name": rb.name, "dir": rulebook_dirs[label],
                                "sha256": rb.sha256} for label, rb in rulebooks.items()]}
+    if "rrt:tuned" in planners:  # the settings the tuned label resolved to (the report names them)
+        from xfuzzy_rrt.planners.tuned import tuned_params
+
+        settings["tuned"] = {"rrt:tuned": tuned_params("rrt")}
     return BenchResult(runs=runs_df, summary=summary, examples=examples, scenarios=by_name,
                        settings=settings, rulebook=main_rb, ratios=ratio_table(summary),
                        rulebooks=dict(rulebooks), worst_examples=worst)

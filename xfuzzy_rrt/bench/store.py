@@ -170,7 +170,8 @@ def _write_examples(result: BenchResult, folder: Path) -> None:
             "success": bool(r.success), "found": bool(r.found), "certified": bool(r.certified),
             "min_clearance_m": r.min_clearance_m, "penetration_m": r.penetration_m,
             "violation": r.violation, "iterations": int(r.iterations), "nodes": int(r.nodes),
-            "cost_deg": r.cost_deg, "wall_s": float(r.wall_s), "rulebook": r.rulebook,
+            "cost_deg": r.cost_deg, "wall_s": float(r.wall_s), "work": r.work,
+            "rulebook": r.rulebook,
             "rulebook_sha256": r.rulebook_sha256, "params": _plain(dict(r.params or {})),
             "path_deg": np.asarray(r.path_deg, dtype=np.float64).tolist(),
             "tree": known[0], "trace": known[1],
@@ -429,5 +430,5 @@ def _read_examples(folder: Path) -> tuple[dict[tuple[str, str], PlanResult],
             tree_nodes_deg=tree[["q1_deg", "q2_deg"]].to_numpy(dtype=np.float64),
             tree_parent=tree["parent"].to_numpy(dtype=np.int64), rulebook=e.get("rulebook"),
             rulebook_sha256=e.get("rulebook_sha256"), params=dict(e.get("params") or {}),
-            trace=trace)
+            trace=trace, work=None if e.get("work") is None else int(e["work"]))
     return out, worst

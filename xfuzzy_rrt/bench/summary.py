@@ -25,7 +25,19 @@ Conventions (the paper's, kept for every planner):
   only (``time_ratio_vs_rrt``; their ``iter_ratio_vs_rrt`` is left empty). The ratio table
   gives the distribution over scenarios (median, worst, best, geometric mean) with the metric
   named in its ``metric`` column -- this is how "2x faster" is judged across many problems
-  instead of one.
+  instead of one;
+- **time and work as the measure** (issue 23): every planner is also ranked on the end-to-end
+  time to the first certified path (``time_total_s``: the whole planner call as a user waits,
+  set-up and certification included) and on its deterministic end-to-end work
+  (``work_total``: distance evaluations plus nearest-neighbour visits of the search, ``work``,
+  plus those of certifying the path, ``certify_work``) -- end to end like the time, and the
+  measure the tuned RRT was tuned on (bench/tuning.py). Medians are over all runs; a run
+  without a certified path counts with the time and the work it spent until its budget ran
+  out (the convention iterations follow with ``max_iter``), so failing costs what it cost
+  the user, and ``success_rate`` stands beside it. ``ratios.csv`` has these rows
+  (``metric`` ``time_total_s`` and ``work_total``) against RRT and, when the benchmark ran it,
+  against the tuned RRT (``baseline`` ``rrt:tuned``): the peer at its best. Iterations stay
+  the paper's measure, against the paper's RRT.
 """
 
 from __future__ import annotations
@@ -34,23 +46,35 @@ import numpy as np
 import pandas as pd
 
 BASELINE = "rrt"
+#: The peer at its best: RRT with tuned step and goal bias (planners/tuned.py).
+TUNED_BASELINE = "rrt:tuned"
 ITERATIONS = "iterations"
 TIME_FIRST = "time_first_s"
+TIME_TOTAL = "time_total_s"
+WORK = "work"
+WORK_TOTAL = "work_total"
 
 SUMMARY_COLUMNS = ["scenario", "planner", "runs", "success_rate", "found_rate", "iterations_min",
                    "iterations_median", "iterations_max", "cost_min", "cost_median", "cost_max",
                    "wall_median_s", "time_first_median_s", "certified_fraction",
                    "penetration_max_m", "min_clearance_min_m", "iter_ratio_vs_rrt",
-                   "time_ratio_vs_rrt"]
+                   "time_ratio_vs_rrt", "time_total_median_s", "work_median",
+                   "work_total_median", "time_total_ratio_vs_rrt", "work_total_ratio_vs_rrt"]
 SHORTCUT_COLUMNS = ["cost_short_median"]
 RATIO_COLUMNS = ["baseline", "planner", "metric", "scenarios", "ratio_median", "ratio_worst",
                  "ratio_best", "ratio_geomean"]
 
 
 def ratio_metric(planner: str) -> str:
-    """What a planner is compared to RRT on: iterations for ours, time to first path for OMPL's
-    (whose iteration counts are not our loop's)."""
+    """What a planner is compared to RRT on in the paper's measure: iterations for ours, time
+    to first path for OMPL's (whose iteration counts are not our loop's)."""
     return TIME_FIRST if str(planner).startswith("ompl:") else ITERATIONS
+
+
+def time_work_baselines(planners) -> list[str]:
+    """The baselines of the time and work rows: RRT, and the tuned RRT when it ran."""
+    names = set(planners)
+    return [b for b in (BASELINE, TUNED_BASELINE) if b in names]
 
 
 def _bool(series: pd.Series) -> pd.Series:
@@ -101,6 +125,9 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
             "certified_fraction": np.nan,
             "penetration_max_m": np.nan,
             "min_clearance_min_m": np.nan,
+            "time_total_median_s": _median(g[TIME_TOTAL]) if TIME_TOTAL in g else np.nan,
+            "work_median": _median(g[WORK]) if WORK in g else np.nan,
+            "work_total_median": _median(g[WORK_TOTAL]) if WORK_TOTAL in g else np.nan,
         }
         if "certified" in g.columns and len(got):
             row["certified_fraction"] = float(_bool(got["certified"]).fillna(False)
@@ -118,6 +145,8 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     frame["iter_ratio_vs_rrt"] = scenario_ratios(frame, metric=ITERATIONS).where(
         frame["planner"].map(ratio_metric) == ITERATIONS)
     frame["time_ratio_vs_rrt"] = scenario_ratios(frame, metric=TIME_FIRST)
+    frame["time_total_ratio_vs_rrt"] = scenario_ratios(frame, metric=TIME_TOTAL)
+    frame["work_total_ratio_vs_rrt"] = scenario_ratios(frame, metric=WORK_TOTAL)
     return frame
 
 
@@ -126,7 +155,8 @@ def _min(values: pd.Series) -> float:
     return float(values.min()) if len(values) else float("nan")
 
 
-_STAT = {ITERATIONS: "iterations_median", TIME_FIRST: "time_first_median_s"}
+_STAT = {ITERATIONS: "iterations_median", TIME_FIRST: "time_first_median_s",
+         TIME_TOTAL: "time_total_median_s", WORK_TOTAL: "work_total_median"}
 
 
 def scenario_ratios(summary: pd.DataFrame, baseline: str = BASELINE,
@@ -134,6 +164,8 @@ def scenario_ratios(summary: pd.DataFrame, baseline: str = BASELINE,
     """Per summary row: baseline median / this planner's, of ``metric`` (NaN without a
     baseline)."""
     col = _STAT[metric]
+    if col not in summary.columns:  # a summary from before the column existed
+        return pd.Series(np.nan, index=summary.index, dtype=float)
     base = summary[summary["planner"] == baseline].set_index("scenario")[col]
     ref = summary["scenario"].map(base).astype(float)
     mine = summary[col].astype(float)
@@ -142,20 +174,39 @@ def scenario_ratios(summary: pd.DataFrame, baseline: str = BASELINE,
 
 
 def ratio_table(summary: pd.DataFrame, baseline: str = BASELINE) -> pd.DataFrame:
-    """Per planner other than ``baseline``: the distribution over scenarios of its per-scenario
-    ratio on its metric (:func:`ratio_metric`; ``worst`` = smallest ratio, ``best`` = largest,
-    ``geomean`` = geometric mean)."""
+    """The distribution over scenarios of per-scenario ratios (``worst`` = smallest ratio,
+    ``best`` = largest, ``geomean`` = geometric mean), one row per (baseline, planner, metric):
+
+    1. against ``baseline`` (RRT), each other planner on its paper metric
+       (:func:`ratio_metric`) -- one row per planner, first, as before;
+    2. against RRT and the tuned RRT (:func:`time_work_baselines`), each other planner on
+       end-to-end time (``time_total_s``) and on end-to-end work (``work_total``) where both
+       have it.
+    """
     rows = []
     others = summary[summary["planner"] != baseline]
     for planner, g in others.groupby("planner", sort=False):
-        metric = ratio_metric(planner)
-        r = scenario_ratios(summary, baseline, metric).loc[g.index].dropna().to_numpy(dtype=float)
-        if r.size == 0:
-            continue
-        rows.append({"baseline": baseline, "planner": planner, "metric": metric,
-                     "scenarios": int(r.size),
-                     "ratio_median": float(np.median(r)), "ratio_worst": float(r.min()),
-                     "ratio_best": float(r.max()),
-                     "ratio_geomean": float(np.exp(np.mean(np.log(r)))) if np.all(r > 0)
-                     else float("nan")})
+        row = _ratio_row(summary, baseline, planner, g.index, ratio_metric(planner))
+        if row is not None:
+            rows.append(row)
+    for base in [baseline] + [b for b in time_work_baselines(summary["planner"])
+                              if b != baseline]:
+        for planner, g in summary[summary["planner"] != base].groupby("planner", sort=False):
+            for metric in (TIME_TOTAL, WORK_TOTAL):
+                row = _ratio_row(summary, base, planner, g.index, metric)
+                if row is not None:
+                    rows.append(row)
     return pd.DataFrame(rows, columns=RATIO_COLUMNS)
+
+
+def _ratio_row(summary: pd.DataFrame, baseline: str, planner: str, index,
+               metric: str) -> dict | None:
+    r = scenario_ratios(summary, baseline, metric).loc[index].dropna().to_numpy(dtype=float)
+    if r.size == 0:
+        return None
+    return {"baseline": baseline, "planner": planner, "metric": metric,
+            "scenarios": int(r.size),
+            "ratio_median": float(np.median(r)), "ratio_worst": float(r.min()),
+            "ratio_best": float(r.max()),
+            "ratio_geomean": float(np.exp(np.mean(np.log(r)))) if np.all(r > 0)
+            else float("nan")}

@@ -43,6 +43,7 @@ def _register() -> None:
     train_cli.register(app)
     __import__("xfuzzy_rrt.cli.evaluate", fromlist=["register"]).register(app)
     __import__("xfuzzy_rrt.cli.robustness", fromlist=["register"]).register(app)
+    __import__("xfuzzy_rrt.cli.tune", fromlist=["register"]).register(app)
     app.add_typer(rules_cli.app, name="rules")
     app.add_typer(scenarios_cli.app, name="scenarios")
 
@@ -56,7 +57,7 @@ def _print_error(line: str) -> None:
 
 
 #: Commands that run compiled planners (``rules`` subcommands that plan are listed as pairs).
-_PLANNING = {"plan", "bench", "demo", "explain", "train", ("rules", "coverage"),
+_PLANNING = {"plan", "bench", "demo", "explain", "train", "tune", ("rules", "coverage"),
              ("rules", "diff"), ("rules", "simplify"), ("scenarios", "generate")}
 
 

@@ -87,6 +87,9 @@ class PathCheck:
     min_config_deg: tuple[float, ...] = ()
     #: First path vertex outside the joint limits (``-1``: none).
     limits_vertex: int = -1
+    #: Distance evaluations the check made (``Problem.work``: the exact minimum clearance and
+    #: the certified edge check), the deterministic cost of certifying this path.
+    work: int = 0
 
     def describe(self) -> str:
         """One sentence on why the path is not certified (empty string when it is)."""
@@ -180,9 +183,10 @@ def certify_path(arrays, path_deg, margin: float = CERT_MARGIN_M) -> PathCheck:
         return PathCheck(certified=ok, penetration_m=penetration,
                          worst_segment=0 if not ok and inside else -1,
                          min_clearance_m=value, min_segment=seg, min_config_deg=where,
-                         limits_vertex=-1 if inside else 0)
+                         limits_vertex=-1 if inside else 0, work=int(problem.work[0]))
     certified, first_bad, first_out = certify_kernel(problem, path, float(margin))
     worst = int(seg) if penetration > 0.0 else (-1 if certified else int(first_bad))
     return PathCheck(certified=bool(certified), penetration_m=float(penetration),
                      worst_segment=worst, min_clearance_m=value, min_segment=int(seg),
-                     min_config_deg=where, limits_vertex=int(first_out))
+                     min_config_deg=where, limits_vertex=int(first_out),
+                     work=int(problem.work[0]))

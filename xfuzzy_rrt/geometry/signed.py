@@ -167,6 +167,7 @@ def element_clearances(P, q_deg, out):
                 if d < best:
                     best = d
                 e += 1
+    P.work[0] += nl * obstacles.shape[0] + (e - nl)  # the work counter (geometry/problem.py)
     return best
 
 

@@ -15,6 +15,9 @@ TRACE_SUFFIXES = (".parquet", ".csv")
 OMPL_PREFIX = "ompl:"
 #: ``fuzzy-rrt:NAME`` (a shipped rulebook) or ``fuzzy-rrt:DIR`` (a rulebook directory).
 FUZZY_PREFIX = "fuzzy-rrt:"
+#: RRT with the step and goal bias of the shipped tuned file (planners/tuned.py); ``rrt``
+#: keeps the paper's 10° and 0.05.
+RRT_TUNED = "rrt:tuned"
 
 
 @dataclass(frozen=True)
@@ -35,7 +38,7 @@ class PlannerSpec:
 def is_known_planner(name: str) -> bool:
     """A built-in planner name, ``fuzzy-rrt:...`` or ``ompl:NAME`` (the part after the colon
     is checked by :func:`parse_planner`). Cheap and import-free, for argument parsing."""
-    return name in PLANNERS or any(name.startswith(p) and len(name) > len(p)
+    return name in PLANNERS or name == RRT_TUNED or any(name.startswith(p) and len(name) > len(p)
                                    for p in (OMPL_PREFIX, FUZZY_PREFIX))
 
 
@@ -78,6 +81,9 @@ def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
     """
     if name in PLANNERS:
         return PlannerSpec(name, name)
+    if name == RRT_TUNED:
+        _tuned_rrt(where)
+        return PlannerSpec(name, "rrt")
     if name.startswith(FUZZY_PREFIX) and len(name) > len(FUZZY_PREFIX):
         return PlannerSpec(name, "fuzzy-rrt", rulebook_dir_of(name[len(FUZZY_PREFIX):], where))
     if name.startswith(OMPL_PREFIX) and len(name) > len(OMPL_PREFIX):
@@ -86,7 +92,8 @@ def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
         check_ompl_planner(name, where)
         return PlannerSpec(name, "ompl")
     raise InputError(where, f"unknown planner {name!r} (expected one of "
-                     f"{', '.join(PLANNERS)}, {FUZZY_PREFIX}RULEBOOK or {OMPL_PREFIX}NAME)")
+                     f"{', '.join(PLANNERS)}, {RRT_TUNED}, {FUZZY_PREFIX}RULEBOOK or "
+                     f"{OMPL_PREFIX}NAME)")
 
 
 def check_planner(name: str, where: str = "--planners") -> str:
@@ -116,6 +123,12 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     if spec.kind == "rrt":
         from xfuzzy_rrt.planners.rrt import plan_rrt
 
+        if spec.label == RRT_TUNED:  # the label fixes the settings: the tuned file's
+            tuned = _tuned_rrt("--planner")
+            result = plan_rrt(scenario, seed=seed, max_iter=max_iter, clearance_m=clearance_m,
+                              max_time_s=max_time_s, **tuned)
+            return dataclasses.replace(result, planner=RRT_TUNED,
+                                       params={**result.params, "tuned": True})
         return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
                         goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
     if spec.kind == "fuzzy-rrt":
@@ -133,6 +146,18 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
 
     return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, step_deg=step_deg,
                      goal_bias=goal_bias, clearance_m=clearance_m, time_limit_s=max_time_s)
+
+
+def _tuned_rrt(where: str) -> dict[str, float]:
+    """``step_deg`` and ``goal_bias`` of the shipped ``rrt.toml``, or one InputError."""
+    from xfuzzy_rrt.planners.tuned import tuned_params, tuned_path
+
+    tuned = tuned_params("rrt")
+    if tuned is None or set(tuned) != {"step_deg", "goal_bias"}:
+        raise InputError(where, f"{RRT_TUNED} needs the tuned file {tuned_path('rrt')} with "
+                         "step_deg and goal_bias (make it with 'xfuzzy-rrt tune rrt --out "
+                         "FILE')")
+    return tuned
 
 
 def _same_rulebook(rulebook, directory: Path) -> bool:

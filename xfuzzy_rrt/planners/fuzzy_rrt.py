@@ -70,7 +70,7 @@ from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
 from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
-from xfuzzy_rrt.planners.tree import TreeArrays, add_node, extract_path, nearest, reset_tree
+from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, extract_path, nearest, reset_tree
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
 MIN_STEP_DEG = default("fuzzy-rrt", "min_step_deg")
@@ -299,6 +299,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         kernel(tuple(problem), tuple(tree), int(seed), 0, knots, consts, mode,
                float(min_step_deg), np.zeros(1, dtype=np.int64), bool(trace), tuple(buffers))
         reset_tree(tree, meta0)
+        problem.work[0] = 0
     with StopFlag(max_time_s) as flag:
         t0 = time.perf_counter()
         ok, iterations, last = kernel(tuple(problem), tuple(tree), int(seed), int(max_iter),
@@ -322,6 +323,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
+        work=int(problem.work[0] + tree.meta[NN_VISITS]),
         rulebook=rb.name, rulebook_sha256=rb.sha256, params=recorded,
     )
     if trace:

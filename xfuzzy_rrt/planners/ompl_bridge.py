@@ -183,7 +183,8 @@ def _valid_cfunc(qptr, ptr):
     k += 2 * dof
     obstacles = data[k:k + 5 * m].reshape((m, 5))
     q = carray(qptr, (dof,), dtype=np.float64)
-    P = Problem(links, arm_first, bases, radii, obstacles, limits, q, q, head[3])
+    P = Problem(links, arm_first, bases, radii, obstacles, limits, q, q, head[3], 0.0,
+                np.zeros(1, dtype=np.int64))
     return config_free(P, q, head[3])
 
 

@@ -20,6 +20,13 @@ time-to-certified-path measure, library loops) never read it. So for a certified
 computation gives, bit for bit. Copy a result with :func:`replace_result`, which carries the
 pending measurement along instead of forcing it (``dataclasses.replace`` works too, but
 measures first).
+
+``work`` is the deterministic work count of the planning (not of the final certification), in
+*distance evaluations*: every exact link-obstacle and link-link distance the collision kernels
+evaluated (``Problem.work``) plus every tree node whose distance to a nearest-neighbour query
+was computed (``TreeArrays.meta[NN_VISITS]``). Same seed, same count, on any machine and with
+any number of workers, so it compares planners where wall-clock time is noisy. ``None`` for a
+planner that does not count (OMPL's, until its bridge counts).
 """
 
 from __future__ import annotations
@@ -116,6 +123,12 @@ class PlanResult:
     #: Why a found path is not certified (one sentence naming the segment, configuration and
     #: depth); ``None`` when certified or when nothing was found.
     violation: str | None = None
+    #: Deterministic work count (module docstring); ``None`` when the planner does not count.
+    work: int | None = None
+    #: The same count for certifying the returned path (exact minimum clearance and certified
+    #: edge check; 0 without a path): ``work + certify_work`` is the end-to-end work, the
+    #: deterministic stand-in for the time a user waits (the tuner's objective).
+    certify_work: int = 0
 
     def __post_init__(self) -> None:
         if self.certified and not self.found:
@@ -150,6 +163,8 @@ class PlanResult:
             "min_clearance_m": _finite_or_none(self.min_clearance_m),
             "penetration_m": _finite_or_none(self.penetration_m),
             "wall_s": float(self.wall_s),
+            "work": None if self.work is None else int(self.work),
+            "certify_work": int(self.certify_work),
             "path_deg": [[float(a) for a in row] for row in self.path_deg],
             "params": dict(self.params),
         }
@@ -203,4 +218,5 @@ def certified_result(arrays, margin: float, found: bool, edges_certified: bool =
     return PlanResult(found=True, certified=check.certified,
                       min_clearance_m=float(check.min_clearance_m),
                       penetration_m=float(check.penetration_m),
-                      violation=None if check.certified else check.describe(), **fields)
+                      violation=None if check.certified else check.describe(),
+                      certify_work=int(check.work), **fields)

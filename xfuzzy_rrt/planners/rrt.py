@@ -26,7 +26,7 @@ from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_resul
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import empty_tree, scenario_arrays
-from xfuzzy_rrt.planners.tree import TreeArrays, add_node, extract_path, nearest, reset_tree
+from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, extract_path, nearest, reset_tree
 
 DEFAULT_STEP_DEG = default("rrt", "step_deg")
 DEFAULT_GOAL_BIAS = default("rrt", "goal_bias")
@@ -95,6 +95,7 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
         meta0 = tree.meta.copy()
         rrt_entry(tuple(problem), tuple(tree), int(seed), 0, *args, np.zeros(1, dtype=np.int64))
         reset_tree(tree, meta0)
+        problem.work[0] = 0
     with StopFlag(max_time_s) as flag:
         t0 = time.perf_counter()
         ok, iterations, last = rrt_entry(tuple(problem), tuple(tree), int(seed), int(max_iter),
@@ -114,5 +115,6 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
+        work=int(problem.work[0] + tree.meta[NN_VISITS]),
         params=recorded,
     )

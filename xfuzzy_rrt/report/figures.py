@@ -84,7 +84,8 @@ _OTHER_COLORS = ("#009E73", "#56B4E9", "#000000", "#999933")
 #: report never share a colour in the usual cases; others by a stable hash.
 _NAMED_COLORS = {"fuzzy-rrt:general": "#D55E00", "fuzzy-rrt:paper": "#CC79A7",
                  "fuzzy-rrt:expert": "#E69F00", "ompl:RRTConnect": "#009E73",
-                 "ompl:RRT": "#56B4E9", "ompl:BITstar": "#000000", "ompl:RRTstar": "#999933"}
+                 "ompl:RRT": "#56B4E9", "ompl:BITstar": "#000000", "ompl:RRTstar": "#999933",
+                 "rrt:tuned": "#7FA7D9"}
 
 
 def planner_color(name: str) -> str:

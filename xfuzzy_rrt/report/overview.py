@@ -13,7 +13,15 @@ Conventions (the same as ``summary.csv`` / ``ratios.csv``):
   over all runs of a scenario (a failed run counts as ``max_iter``); OMPL planners count other
   things, so they are compared on time to first path (median over the runs that found one);
 - a ratio is ``RRT's median / the planner's median`` on the same scenario: above 1 the planner
-  is better; "loses" counts scenarios with a ratio below 1.
+  is better; "loses" counts scenarios with a ratio below 1;
+- **time and work as the measure** (issue 23): when ``runs.csv`` has them, every planner is
+  also compared on end-to-end time to the first certified path (``time_total_s``, the whole
+  planner call) and on its deterministic end-to-end work count (``work_total``: the search's
+  ``work`` plus the certification's ``certify_work``), medians over all runs (a
+  failed run counts with what it spent), against the peer at its best -- the tuned RRT
+  (``rrt:tuned``) when the benchmark ran it, else RRT. The verdict leads with that
+  comparison and names the baseline with its settings; iterations stay the paper's measure,
+  against the paper's RRT.
 """
 
 from __future__ import annotations
@@ -22,16 +30,23 @@ import numpy as np
 import pandas as pd
 
 BASELINE = "rrt"
+#: The peer at its best (planners/tuned.py): the time and work baseline when it ran.
+TUNED_BASELINE = "rrt:tuned"
+TIME_TOTAL = "time_total_s"
+WORK = "work_total"  # end to end, like the time: the search plus the certification
 
 PLANNER_COLUMNS = ["planner", "label", "metric", "scenarios", "runs", "success_rate",
                    "found_rate", "ratio_median", "ratio_worst", "ratio_best", "ratio_geomean",
                    "losses", "compared", "time_first_median_s", "cost_median_deg",
-                   "min_clearance_m", "paths", "penetrating_paths", "penetration_max_m"]
+                   "min_clearance_m", "paths", "penetrating_paths", "penetration_max_m",
+                   "time_baseline", "time_ratio_median", "time_ratio_worst", "time_losses",
+                   "time_compared", "work_ratio_median", "work_ratio_worst", "work_losses",
+                   "work_compared", "time_total_median_s", "work_median"]
 
 
 def is_ours(planner: str) -> bool:
-    """RRT and Fuzzy-RRT (any rulebook) count the same loop iterations."""
-    return planner == "rrt" or planner == "fuzzy-rrt" or planner.startswith("fuzzy-rrt:")
+    """RRT (paper or tuned) and Fuzzy-RRT (any rulebook) count the same loop iterations."""
+    return (planner in ("rrt", TUNED_BASELINE, "fuzzy-rrt") or planner.startswith("fuzzy-rrt:"))
 
 
 def metric_of(planner: str) -> str:
@@ -43,6 +58,8 @@ def planner_label(planner: str) -> str:
     """``Fuzzy-RRT `general``` style display names (``ompl:RRTConnect`` -> ``OMPL RRTConnect``)."""
     if planner == "rrt":
         return "RRT"
+    if planner == TUNED_BASELINE:
+        return "RRT tuned"
     if planner == "fuzzy-rrt":
         return "Fuzzy-RRT"
     if planner.startswith("fuzzy-rrt:"):
@@ -81,8 +98,8 @@ def success_mask(runs: pd.DataFrame) -> pd.Series:
 
 
 def scenario_medians(runs: pd.DataFrame) -> pd.DataFrame:
-    """Per (scenario, planner): median iterations (all runs) and median time to first path
-    (runs that found one)."""
+    """Per (scenario, planner): median iterations (all runs), median time to first path (runs
+    that found one), and median end-to-end time and work (all runs; NaN without the column)."""
     found = found_mask(runs)
     rows = []
     for (scen, planner), g in runs.groupby(["scenario", "planner"], sort=False):
@@ -90,8 +107,66 @@ def scenario_medians(runs: pd.DataFrame) -> pd.DataFrame:
               if "time_first_s" in g.columns else pd.Series(dtype=float))
         rows.append({"scenario": str(scen), "planner": str(planner),
                      "iterations": float(pd.to_numeric(g["iterations"]).median()),
-                     "time_first_s": float(tf.median()) if len(tf) else np.nan})
-    return pd.DataFrame(rows, columns=["scenario", "planner", "iterations", "time_first_s"])
+                     "time_first_s": float(tf.median()) if len(tf) else np.nan,
+                     TIME_TOTAL: _all_runs_median(g, TIME_TOTAL),
+                     WORK: _all_runs_median(g, WORK)})
+    return pd.DataFrame(rows, columns=["scenario", "planner", "iterations", "time_first_s",
+                                       TIME_TOTAL, WORK])
+
+
+def _all_runs_median(g: pd.DataFrame, column: str) -> float:
+    """Median over every run (NaN when the column is missing or any run lacks a value: a
+    planner that does not count work is not compared on work)."""
+    if column not in g.columns:
+        return np.nan
+    v = pd.to_numeric(g[column], errors="coerce")
+    return float(v.median()) if len(v) and v.notna().all() else np.nan
+
+
+def time_baseline(planners) -> str:
+    """The baseline of the time and work comparison: the tuned RRT when it ran, else RRT."""
+    return TUNED_BASELINE if TUNED_BASELINE in set(planners) else BASELINE
+
+
+def baseline_description(planner: str, tuned: dict | None = None) -> str:
+    """The baseline named with its settings: ``RRT tuned (step 60°, goal bias 0.1)``.
+
+    ``tuned`` is the benchmark's record of what ``rrt:tuned`` resolved to (``bench.json``
+    settings); without it, the shipped tuned file."""
+    from xfuzzy_rrt.report.numbers import sig
+
+    if planner == TUNED_BASELINE:
+        params = (tuned or {}).get(TUNED_BASELINE)
+        if params is None:
+            from xfuzzy_rrt.planners.tuned import tuned_params
+
+            params = tuned_params("rrt") or {}
+        return (f"RRT tuned (step {sig(params.get('step_deg'))}\u00b0, goal bias "
+                f"{sig(params.get('goal_bias'))})")
+    if planner == BASELINE:
+        from xfuzzy_rrt.planners.params import default
+
+        return (f"RRT (step {sig(default('rrt', 'step_deg'))}\u00b0, goal bias "
+                f"{sig(default('rrt', 'goal_bias'))})")
+    return planner_label(planner)
+
+
+def time_work_ratios(runs: pd.DataFrame, baseline: str | None = None) -> pd.DataFrame:
+    """Per (scenario, planner other than ``baseline``, metric in time_total_s/work): the two
+    medians and ``ratio = baseline / planner`` (NaN when either is missing)."""
+    med = scenario_medians(runs)
+    baseline = time_baseline(med["planner"]) if baseline is None else baseline
+    base = med[med["planner"] == baseline].set_index("scenario")
+    rows = []
+    for r in med[med["planner"] != baseline].itertuples(index=False):
+        for m in (TIME_TOTAL, WORK):
+            mine = float(getattr(r, m))
+            ref = float(base.loc[r.scenario, m]) if r.scenario in base.index else np.nan
+            ratio = ref / mine if (np.isfinite(ref) and np.isfinite(mine) and mine > 0) else np.nan
+            rows.append({"scenario": r.scenario, "planner": r.planner, "metric": m,
+                         "baseline_value": ref, "value": mine, "ratio": ratio})
+    return pd.DataFrame(rows, columns=["scenario", "planner", "metric", "baseline_value",
+                                       "value", "ratio"])
 
 
 def scenario_ratios(runs: pd.DataFrame, baseline: str = BASELINE) -> pd.DataFrame:
@@ -114,6 +189,9 @@ def scenario_ratios(runs: pd.DataFrame, baseline: str = BASELINE) -> pd.DataFram
 def planner_table(runs: pd.DataFrame, baseline: str = BASELINE) -> pd.DataFrame:
     """One row per planner: the facts of the first screen (see the module docstring)."""
     ratios = scenario_ratios(runs, baseline)
+    tbase = time_baseline(runs["planner"])
+    tw = time_work_ratios(runs, tbase)
+    med = scenario_medians(runs)
     found = found_mask(runs)
     success = success_mask(runs)
     rows = []
@@ -150,8 +228,23 @@ def planner_table(runs: pd.DataFrame, baseline: str = BASELINE) -> pd.DataFrame:
             "paths": int(len(paths)),
             "penetrating_paths": int(((pen > 0) | uncert).sum()),
             "penetration_max_m": float(pen.max()) if len(pen) and pen.max() > 0 else 0.0,
+            "time_baseline": tbase,
+            "time_total_median_s": _nan_median(med.loc[med["planner"] == p, TIME_TOTAL]),
+            "work_median": _nan_median(med.loc[med["planner"] == p, WORK]),
         })
+        for m, key in ((TIME_TOTAL, "time"), (WORK, "work")):
+            t = tw.loc[(tw["planner"] == p) & (tw["metric"] == m), "ratio"].dropna()
+            t = t.to_numpy(dtype=float)
+            rows[-1].update({f"{key}_ratio_median": float(np.median(t)) if t.size else np.nan,
+                             f"{key}_ratio_worst": float(t.min()) if t.size else np.nan,
+                             f"{key}_losses": int(np.sum(t < 1.0)),
+                             f"{key}_compared": int(t.size)})
     return pd.DataFrame(rows, columns=PLANNER_COLUMNS)
+
+
+def _nan_median(values: pd.Series) -> float:
+    v = pd.to_numeric(values, errors="coerce").dropna()
+    return float(v.median()) if len(v) else np.nan
 
 
 def _x(value: float) -> str:
@@ -160,13 +253,50 @@ def _x(value: float) -> str:
     return f"{sig(value, 2 if 0.1 <= value < 100 else 3)}\u00d7"
 
 
-def verdict(row, baseline_label: str = "RRT") -> str:
-    """The sentence for one planner row of :func:`planner_table` (plain text, no markup)."""
+def _time_work_clause(row, problems: str, time_label: str) -> str | None:
+    """``X finds its first certified path 1.3× faster than RRT tuned (step 60°, goal bias
+    0.1) end to end on 24 problems (median; it loses on 5, worst 0.41×) and needs 1.2× less
+    work (median; worst 0.5×)``; ``None`` without end-to-end times."""
+    med = pd.to_numeric(row.get("time_ratio_median", np.nan), errors="coerce")
+    if not np.isfinite(med):
+        return None
+    n = int(row["scenarios"])
+    compared = int(row["time_compared"])
+    on = f"on {problems}" if compared == n else f"on {compared} of {problems}"
+    shown = _x(med if med >= 1 else 1 / med)
+    if shown == _x(1.0):
+        lead = f"{row['label']} finds its first certified path as fast as {time_label}"
+    else:
+        lead = (f"{row['label']} finds its first certified path {shown} "
+                f"{'faster' if med >= 1 else 'slower'} than {time_label}")
+    losses = int(row["time_losses"])
+    lost = ("it loses on none" if losses == 0 else
+            f"it loses on {losses}, worst {_x(row['time_ratio_worst'])}")
+    text = f"{lead} end to end {on} (median; {lost})"
+    wmed = pd.to_numeric(row.get("work_ratio_median", np.nan), errors="coerce")
+    if np.isfinite(wmed):
+        wshown = _x(wmed if wmed >= 1 else 1 / wmed)
+        what = ("as much end-to-end work" if wshown == _x(1.0) else
+                f"{wshown} {'less' if wmed >= 1 else 'more'} end-to-end work")
+        text += f" and needs {what} (median; worst {_x(row['work_ratio_worst'])})"
+    return text
+
+
+def verdict(row, baseline_label: str = "RRT", time_label: str | None = None) -> str:
+    """The sentence for one planner row of :func:`planner_table` (plain text, no markup).
+
+    ``time_label`` names the time-and-work baseline with its settings
+    (:func:`baseline_description`); the clause comparing end-to-end time and work comes first
+    when the runs have them."""
     from xfuzzy_rrt.report.numbers import metres, percent, seconds
 
     n = int(row["scenarios"])
     problems = f"{n} problem{'s' if n != 1 else ''}"
     parts = []
+    if time_label is not None and row["planner"] != row.get("time_baseline"):
+        clause = _time_work_clause(row, problems, time_label)
+        if clause is not None:
+            parts.append(clause)
     if row["planner"] == BASELINE:
         parts.append(f"{row['label']} (the baseline) solves {percent(row['success_rate'])} of "
                      f"its runs with a certified path on {problems}; median time to first path "
@@ -208,9 +338,15 @@ def verdict(row, baseline_label: str = "RRT") -> str:
     return "; ".join(parts) + "."
 
 
-def verdicts(table: pd.DataFrame) -> list[str]:
-    """One sentence per planner, the baseline's last (it is the reference, not the news)."""
+def verdicts(table: pd.DataFrame, tuned: dict | None = None) -> list[str]:
+    """One sentence per planner, the baseline's last (it is the reference, not the news).
+
+    ``tuned``: the benchmark's record of the tuned settings (``bench.json`` ``settings.tuned``)
+    so that the time baseline is named with the values it ran with."""
     base = table[table["planner"] == BASELINE]
     label = str(base["label"].iloc[0]) if len(base) else planner_label(BASELINE)
-    others = [verdict(r, label) for _, r in table[table["planner"] != BASELINE].iterrows()]
-    return others + [verdict(r, label) for _, r in base.iterrows()]
+    tl = None
+    if "time_baseline" in table.columns and len(table):
+        tl = baseline_description(str(table["time_baseline"].iloc[0]), tuned)
+    others = [verdict(r, label, tl) for _, r in table[table["planner"] != BASELINE].iterrows()]
+    return others + [verdict(r, label, tl) for _, r in base.iterrows()]

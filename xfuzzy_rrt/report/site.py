@@ -227,7 +227,8 @@ def _overview(ctx) -> str:
     page.add(f'<p class="muted xf-sub">{esc(SEP.join(b for b in bits if b))}{SEP}'
              '<a href="#provenance">command and provenance</a></p>')
     page.add('<ul class="xf-verdict" id="verdict">'
-             + "".join(f"<li>{esc(s)}</li>" for s in verdicts(table_)) + "</ul>")
+             + "".join(f"<li>{esc(s)}</li>" for s in verdicts(table_, settings.get("tuned")))
+             + "</ul>")
     page.add(_planner_table(table_))
     page.add(_ratio_plot(ctx, runs))
     page.heading("Certification: the worst path of each planner", anchor="certification")
@@ -249,14 +250,28 @@ def _overview(ctx) -> str:
 
 
 def _planner_table(t: pd.DataFrame) -> str:
+    timed = "time_ratio_median" in t.columns and t["time_ratio_median"].notna().any()
+    tb = F.planner_label(str(t["time_baseline"].iloc[0])) if timed else ""
     header = ["planner", "certified success", "found a path", "compared on",
               "median ratio to RRT", "worst ratio", "loses on", "median time to first path",
               "median cost", "min clearance", "penetrating paths"]
+    if timed:
+        header[1:1] = [f"end-to-end time vs {tb} (median / worst)",
+                       f"end-to-end work vs {tb} (median / worst)", "median end-to-end time",
+                       "median end-to-end work"]
     rows = []
     for r in t.itertuples(index=False):
         base = r.planner == BASELINE
+        lead = []
+        if timed:
+            tbase = r.planner == r.time_baseline
+            lead = ["1\u00d7 (baseline)" if tbase else
+                    f"{N.ratio(r.time_ratio_median)} / {N.ratio(r.time_ratio_worst)}",
+                    "1\u00d7 (baseline)" if tbase else
+                    f"{N.ratio(r.work_ratio_median)} / {N.ratio(r.work_ratio_worst)}",
+                    N.seconds(r.time_total_median_s), N.sig(r.work_median, 3)]
         rows.append([
-            r.label, N.percent(r.success_rate), N.percent(r.found_rate),
+            r.label, *lead, N.percent(r.success_rate), N.percent(r.found_rate),
             "\u2014" if base else ("iterations" if r.metric == "iterations"
                                    else "time to first path"),
             "1\u00d7 (baseline)" if base else N.ratio(r.ratio_median),

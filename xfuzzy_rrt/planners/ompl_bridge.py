@@ -39,12 +39,14 @@ an OMPL run here is set up exactly as our planners are
   names the source used. ``nodes`` is the number of vertices in the planner data.
 - **Validity: our checker.** A state is valid iff
   :func:`~xfuzzy_rrt.geometry.collision.config_free` holds with the scenario's margin (its
-  clearance folded in). It runs as a numba ``cfunc`` over a packed float64 buffer, called
-  through ctypes from a short Python callback (the bindings only accept a Python callable).
+  clearance folded in). It runs compiled (:func:`state_free_at`, numba) over a packed float64
+  buffer, called with four integer addresses from a short Python callback (the bindings only
+  accept a Python callable).
 - **Motions: our certified edge check** (``ompl:NAME``, ``params["motion_validator"] ==
   "certified"``). OMPL asks a :class:`ob.MotionValidator <ompl.base.MotionValidator>` subclass,
   whose ``checkMotion(s1, s2)`` copies both states into two preallocated arrays (one
-  projection call each) and makes one ctypes call into a compiled ``cfunc`` that runs
+  projection call each) and makes one call into a compiled function (:func:`motion_free_at`)
+  that runs
   :func:`~xfuzzy_rrt.geometry.collision.edge_free` (conservative advancement) on the whole
   straight segment -- OMPL's ``RealVectorStateSpace`` interpolates linearly, so that segment is
   exactly the motion the planner adds. Every edge of every OMPL tree is therefore certified, and
@@ -98,7 +100,6 @@ silenced during a plan (it would otherwise warn that re-seeding happens after th
 
 from __future__ import annotations
 
-import ctypes
 import functools
 import math
 import time
@@ -106,7 +107,8 @@ from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
-from numba import carray
+from numba import carray, types
+from numba.core.extending import intrinsic
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry import collision
@@ -358,30 +360,48 @@ def _bundle_plain(ptr, counts, q):
 _bundle = _bundle_counting if COUNTS_WORK else _bundle_plain
 
 
-@nb.cfunc(nb.types.boolean(nb.types.voidptr, nb.types.voidptr, nb.types.voidptr), cache=True)
-def _valid_cfunc(qptr, ptr, cptr):
-    """Compiled check of the configuration at ``qptr`` in the :func:`pack_scenario` buffer at
-    ``ptr`` (counters at ``cptr``): the planners' own
-    :func:`~xfuzzy_rrt.geometry.collision.config_free`."""
+@intrinsic
+def _at(typingctx, address):
+    """The integer ``address`` (a buffer's ``ctypes.data``, held by Python) as a ``void*``."""
+    if not isinstance(address, types.Integer):
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], context.get_value_type(types.voidptr))
+
+    return types.voidptr(address), codegen
+
+
+@nb.njit(cache=True, nogil=True)
+def state_free_at(q_at, buffer_at, counts_at):
+    """Compiled check of the configuration at address ``q_at`` in the :func:`pack_scenario`
+    buffer at ``buffer_at`` (counters at ``counts_at``): the planners' own
+    :func:`~xfuzzy_rrt.geometry.collision.config_free`.
+
+    Why addresses: OMPL calls a Python callable, and a compiled function taking four integers
+    is the cheapest compiled call Python can make (numba's dispatcher types integers at once;
+    ctypes costs about twice as much, arrays more).
+    """
+    ptr = _at(buffer_at)
     head = carray(ptr, (_HEADER,), dtype=np.float64)
-    counts = carray(cptr, (N_COUNTS,), dtype=np.int64)
-    q = carray(qptr, (int(head[0]),), dtype=np.float64)
+    counts = carray(_at(counts_at), (N_COUNTS,), dtype=np.int64)
+    q = carray(_at(q_at), (int(head[0]),), dtype=np.float64)
     P = _bundle(ptr, counts, q)
     counts[STATE_CHECKS] += 1
     return config_free(P, q, P.margin)
 
 
-@nb.cfunc(nb.types.boolean(nb.types.voidptr, nb.types.voidptr, nb.types.voidptr,
-                           nb.types.voidptr), cache=True)
-def _motion_cfunc(aptr, bptr, ptr, cptr):
-    """Compiled certified check of the straight motion from the configuration at ``aptr`` to
-    the one at ``bptr``: :func:`~xfuzzy_rrt.geometry.collision.edge_free` on the whole
+@nb.njit(cache=True, nogil=True)
+def motion_free_at(qa_at, qb_at, buffer_at, counts_at):
+    """Compiled certified check of the straight motion from the configuration at ``qa_at`` to
+    the one at ``qb_at``: :func:`~xfuzzy_rrt.geometry.collision.edge_free` on the whole
     segment, both ends within the joint limits (``edge_free`` assumes it)."""
+    ptr = _at(buffer_at)
     head = carray(ptr, (_HEADER,), dtype=np.float64)
-    counts = carray(cptr, (N_COUNTS,), dtype=np.int64)
+    counts = carray(_at(counts_at), (N_COUNTS,), dtype=np.int64)
     dof = int(head[0])
-    qa = carray(aptr, (dof,), dtype=np.float64)
-    qb = carray(bptr, (dof,), dtype=np.float64)
+    qa = carray(_at(qa_at), (dof,), dtype=np.float64)
+    qb = carray(_at(qb_at), (dof,), dtype=np.float64)
     P = _bundle(ptr, counts, qa)
     counts[MOTION_CHECKS] += 1
     ok = within_limits(P.limits, qa) and within_limits(P.limits, qb) and \
@@ -389,23 +409,6 @@ def _motion_cfunc(aptr, bptr, ptr, cptr):
     if not ok:
         counts[MOTIONS_REFUSED] += 1
     return ok
-
-
-def _ctypes_of(cfunc, n_args: int):
-    fn = cfunc.ctypes
-    fn.argtypes = [ctypes.c_void_p] * n_args
-    fn.restype = ctypes.c_bool
-    return fn
-
-
-def validity_cfunc():
-    """The compiled check ``(q_deg*, buffer*, counts*) -> bool`` as a ctypes function."""
-    return _ctypes_of(_valid_cfunc, 3)
-
-
-def motion_cfunc():
-    """The compiled certified motion check ``(qa_deg*, qb_deg*, buffer*, counts*) -> bool``."""
-    return _ctypes_of(_motion_cfunc, 4)
 
 
 def new_counts() -> np.ndarray:
@@ -422,7 +425,7 @@ def make_validity_callback(arrays, margin: float = CERT_MARGIN_M, counts=None):
     """
     buffer = pack_scenario(arrays, margin)
     counts = new_counts() if counts is None else counts
-    fn = validity_cfunc()
+    fn = state_free_at
     dof = arrays.links.shape[0]
     q = np.empty(dof, dtype=np.float64)
     joints = range(dof)
@@ -445,8 +448,8 @@ def _certified_validator_class():
         """OMPL motion validator that runs the certified edge check, compiled.
 
         One Python call per motion: both states are copied by OMPL's identity projection
-        (one C++ call each) into preallocated arrays, then one ctypes call runs
-        :func:`_motion_cfunc`. It must not hold the ``SpaceInformation``'s Python object (that
+        (one C++ call each) into preallocated arrays, then one compiled call,
+        :func:`motion_free_at`, checks the whole segment. It must not hold the ``SpaceInformation``'s Python object (that
         would make a cycle through C++ that the garbage collector cannot see).
         """
 
@@ -459,7 +462,7 @@ def _certified_validator_class():
             self._qb = np.empty(dof, dtype=np.float64)
             self._buffer = pack_scenario(arrays, margin)
             self._counts = counts
-            self._fn = motion_cfunc()
+            self._fn = motion_free_at
             self._args = (self._qa.ctypes.data, self._qb.ctypes.data,
                           self._buffer.ctypes.data, counts.ctypes.data)
 

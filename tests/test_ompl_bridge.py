@@ -410,3 +410,16 @@ def test_a_pytest_run_that_plans_with_bitstar_ends_without_nanobind_leak_lines()
                               test, "-k", "no_such_test"], capture_output=True, text=True,
                              timeout=300, cwd=PROJECT)
     assert failing.returncode == 5  # "no tests collected": the real exit status survives
+
+
+def test_the_compiled_checks_are_ready_at_import_not_compiled_inside_a_timed_solve():
+    # Compiling inside OMPL's solve() would spend the first plan's wall-clock cap on numba.
+    import subprocess
+
+    code = ("import os, xfuzzy_rrt.planners.ompl_bridge as b; "
+            "print(len(b.state_free_at.overloads), len(b.motion_free_at.overloads), flush=True); "
+            "os._exit(0)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=600, cwd=PROJECT)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["1", "1"]

@@ -372,7 +372,13 @@ def _at(typingctx, address):
     return types.voidptr(address), codegen
 
 
-@nb.njit(cache=True, nogil=True)
+#: Explicit signatures: compiled (or loaded from the cache) at import, like a ``cfunc``, so the
+#: first plan of a process does not compile inside OMPL's timed ``solve`` (and hit its cap).
+_AT3 = nb.types.boolean(nb.types.intp, nb.types.intp, nb.types.intp)
+_AT4 = nb.types.boolean(nb.types.intp, nb.types.intp, nb.types.intp, nb.types.intp)
+
+
+@nb.njit(_AT3, cache=True, nogil=True)
 def state_free_at(q_at, buffer_at, counts_at):
     """Compiled check of the configuration at address ``q_at`` in the :func:`pack_scenario`
     buffer at ``buffer_at`` (counters at ``counts_at``): the planners' own
@@ -391,7 +397,7 @@ def state_free_at(q_at, buffer_at, counts_at):
     return config_free(P, q, P.margin)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(_AT4, cache=True, nogil=True)
 def motion_free_at(qa_at, qb_at, buffer_at, counts_at):
     """Compiled certified check of the straight motion from the configuration at ``qa_at`` to
     the one at ``qb_at``: :func:`~xfuzzy_rrt.geometry.collision.edge_free` on the whole

@@ -40,7 +40,7 @@ an OMPL run here is set up exactly as our planners are
 - **Validity: our checker.** A state is valid iff
   :func:`~xfuzzy_rrt.geometry.collision.config_free` holds with the scenario's margin (its
   clearance folded in). It runs compiled (:func:`state_free_at`, numba) over a packed float64
-  buffer, called with four integer addresses from a short Python callback (the bindings only
+  buffer, called with integer addresses from a short Python callback (the bindings only
   accept a Python callable).
 - **Motions: our certified edge check** (``ompl:NAME``, ``params["motion_validator"] ==
   "certified"``). OMPL asks a :class:`ob.MotionValidator <ompl.base.MotionValidator>` subclass,
@@ -422,25 +422,28 @@ def new_counts() -> np.ndarray:
     return np.zeros(N_COUNTS, dtype=np.int64)
 
 
-def make_validity_callback(arrays, margin: float = CERT_MARGIN_M, counts=None):
+def make_validity_callback(arrays, margin: float = CERT_MARGIN_M, counts=None, space=None):
     """A Python callable ``state -> bool`` for OMPL that runs our compiled check.
 
     ``counts`` (from :func:`new_counts`) receives the number of checks (and the work when the
-    problem bundle counts it). The buffers are bound as default arguments so they live as long
-    as the callback.
+    problem bundle counts it). The state is copied by OMPL's identity projection of ``space``
+    (the planning ``RealVectorStateSpace``; a fresh one of the same dimension if ``None``): one
+    C++ call instead of one Python indexing per joint. The buffers and the projection are bound
+    as default arguments so they live as long as the callback.
     """
+    ob, _, _ = import_ompl("--planner")
     buffer = pack_scenario(arrays, margin)
     counts = new_counts() if counts is None else counts
-    fn = state_free_at
     dof = arrays.links.shape[0]
+    space = ob.RealVectorStateSpace(dof) if space is None else space
+    projection = ob.RealVectorIdentityProjectionEvaluator(space)
     q = np.empty(dof, dtype=np.float64)
-    joints = range(dof)
 
-    def is_valid(state, _fn=fn, _q=q, _qa=q.ctypes.data, _address=buffer.ctypes.data,
-                 _ca=counts.ctypes.data, _keep=(buffer, counts)):
-        for j in joints:
-            _q[j] = state[j]
-        return _fn(_qa, _address, _ca)
+    def is_valid(state, _project=projection.project, _fn=state_free_at, _q=q,
+                 _args=(q.ctypes.data, buffer.ctypes.data, counts.ctypes.data),
+                 _keep=(buffer, counts, projection, space)):
+        _project(state, _q)
+        return _fn(*_args)
 
     return is_valid
 
@@ -455,8 +458,9 @@ def _certified_validator_class():
 
         One Python call per motion: both states are copied by OMPL's identity projection
         (one C++ call each) into preallocated arrays, then one compiled call,
-        :func:`motion_free_at`, checks the whole segment. It must not hold the ``SpaceInformation``'s Python object (that
-        would make a cycle through C++ that the garbage collector cannot see).
+        :func:`motion_free_at`, checks the whole segment. It must not hold the
+        ``SpaceInformation``'s Python object (that would make a cycle through C++ that the
+        garbage collector cannot see).
         """
 
         def __init__(self, si, space, arrays, margin: float, counts: np.ndarray):
@@ -473,10 +477,8 @@ def _certified_validator_class():
                           self._buffer.ctypes.data, counts.ctypes.data)
 
         def checkMotion(self, s1, s2):  # noqa: N802 - OMPL's name
-            qa = self._qa
-            qb = self._qb
-            self._project(s1, qa)
-            self._project(s2, qb)
+            self._project(s1, self._qa)
+            self._project(s2, self._qb)
             return self._fn(*self._args)
 
     return CertifiedMotionValidator
@@ -530,7 +532,6 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
     a = scenario.arrays()
     dof = a.links.shape[0]
     counts = new_counts()
-    callback = make_validity_callback(a, margin, counts)
 
     previous_level = ou.getLogLevel()
     ou.setLogLevel(ou.LOG_NONE)
@@ -544,7 +545,7 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
             bounds.setHigh(j, float(a.limits_deg[j, 1]))
         space.setBounds(bounds)
         si = ob.SpaceInformation(space)
-        si.setStateValidityChecker(callback)
+        si.setStateValidityChecker(make_validity_callback(a, margin, counts, space))
         if spec.sampled:
             if validity_resolution is not None:
                 si.setStateValidityCheckingResolution(float(validity_resolution))

@@ -163,7 +163,14 @@ def import_ompl(where: str = "--planners"):
 
 def ompl_planner_names(where: str = "--planners") -> tuple[str, ...]:
     """Geometric planners this OMPL build exposes and ``ompl:NAME`` accepts (not UNSUPPORTED)."""
-    ob, og, _ = import_ompl(where)
+    import_ompl(where)
+    return _planner_names()
+
+
+@functools.cache
+def _planner_names() -> tuple[str, ...]:
+    # Cached: every plan validates its label, and scanning the module is not free.
+    ob, og, _ = import_ompl()
     names = []
     for name in dir(og):
         obj = getattr(og, name)
@@ -588,6 +595,8 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
             return False
 
         ptc = ob.PlannerTerminationCondition(terminate)
+        # One C++ call per state read back (path and tree), not one Python index per joint.
+        copy_state = ob.RealVectorIdentityProjectionEvaluator(space).project
         t0 = time.perf_counter()
         deadline[0] = t0 + time_limit_s
         status = str(p.solve(ptc))
@@ -599,7 +608,9 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
         failure = None
         if exact:
             states = pdef.getSolutionPath().getStates()
-            path = np.array([[s[j] for j in range(dof)] for s in states], dtype=np.float64)
+            path = np.empty((len(states), dof), dtype=np.float64)
+            for k, s in enumerate(states):
+                copy_state(s, path[k])
             if not np.array_equal(path[0], a.start_deg):
                 exact, failure = False, "path does not start at the start configuration"
             elif not np.array_equal(path[-1], a.goal_deg):
@@ -623,9 +634,7 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
         tree = np.empty((n, dof), dtype=np.float64)
         parent = np.full(n, -1, dtype=np.int64)
         for i in range(n):
-            s = data.getVertex(i).getState()
-            for j in range(dof):
-                tree[i, j] = s[j]
+            copy_state(data.getVertex(i).getState(), tree[i])
             for child in data.getEdges(i):
                 parent[int(child)] = i
         if spec.sampled:
@@ -671,7 +680,9 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
     return result
 
 
+@functools.cache
 def _ompl_version() -> str:
+    # Cached: reading the package metadata costs milliseconds, more than many OMPL solves.
     try:
         from importlib.metadata import version
 

@@ -391,9 +391,10 @@ def state_free_at(q_at, buffer_at, counts_at):
     buffer at ``buffer_at`` (counters at ``counts_at``): the planners' own
     :func:`~xfuzzy_rrt.geometry.collision.config_free`.
 
-    Why addresses: OMPL calls a Python callable, and a compiled function taking four integers
-    is the cheapest compiled call Python can make (numba's dispatcher types integers at once;
-    ctypes costs about twice as much, arrays more).
+    Why addresses: OMPL calls a Python callable, and a compiled function taking only integers
+    is the cheapest compiled call we found from Python (numba's dispatcher types integers at
+    once; calling a ``cfunc`` through ctypes cost more per call in our measurements, passing
+    arrays more still). The caller keeps the buffers alive while the addresses are in use.
     """
     ptr = _at(buffer_at)
     head = carray(ptr, (_HEADER,), dtype=np.float64)

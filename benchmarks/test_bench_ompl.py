@@ -1,12 +1,22 @@
-"""OMPL peers: cost of the compiled validity callback, and OMPL plans on the reference problem.
+"""OMPL peers: cost of the compiled validity and motion callbacks, and OMPL plans on the
+reference problem.
 
 The validity callback is called by OMPL for every state it checks, so its per-call cost is
 part of every OMPL time we report. Three variants are timed per call on the same state:
 
-- ``compiled``: what the bridge uses (a two-line Python callable around a numba ``cfunc``
-  reached through ctypes),
+- ``compiled``: what the bridge uses (a two-line Python callable around a compiled numba
+  function called with integer addresses),
 - ``python``: the same check written in plain Python (exact capsule–circle/box distances),
 - ``via_isValid``: the compiled callback as OMPL calls it (``SpaceInformation.isValid``).
+
+The certified motion validator (``ompl:NAME``) is called once per motion; its overhead over
+the compiled edge check itself is measured on the same set of motions
+(:func:`motion_overhead`): ``compiled_us`` (``edge_free`` in a numba loop, no Python),
+``from_python_us`` (the bridge's compiled ``motion_free_at`` called from a Python loop),
+``via_ompl_us`` (OMPL's ``SpaceInformation.checkMotion`` with the certified validator: C++ ->
+Python override -> two projections -> ``motion_free_at``) and ``dispatch_us`` (the same call to a Python validator
+that returns True at once). Print it with
+``.venv/bin/python benchmarks/test_bench_ompl.py [SCENARIO.toml ...]``.
 
 Run: ``.venv/bin/python -m pytest benchmarks/test_bench_ompl.py --benchmark-only``.
 """
@@ -14,13 +24,18 @@ Run: ``.venv/bin/python -m pytest benchmarks/test_bench_ompl.py --benchmark-only
 from __future__ import annotations
 
 import math
+import sys
+import time
 
+import numba as nb
 import numpy as np
 import pytest
 
-from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
+from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M, config_free, edge_free
 from xfuzzy_rrt.geometry.path_check import certify_path
-from xfuzzy_rrt.planners.ompl_bridge import make_validity_callback, plan_ompl
+from xfuzzy_rrt.planners.ompl_bridge import (certified_motion_validator, make_validity_callback,
+                                             motion_free_at, new_counts, pack_scenario,
+                                             plan_ompl)
 
 SEEDS = range(50)
 
@@ -137,7 +152,117 @@ def test_validity_callback_via_ompl_isvalid(benchmark, scenario, state):
     _per_call(benchmark, si.isValid, s)
 
 
-@pytest.mark.parametrize("planner", ["RRT", "RRTConnect", "BITstar"])
+@nb.njit(cache=True)
+def _edge_checks(P, qa, qb, margin):
+    free = 0
+    for i in range(qa.shape[0]):
+        free += edge_free(P, qa[i], qb[i], margin)
+    return free
+
+
+def _motions(arrays, n: int, length_deg: float, seed: int = 0):
+    """``n`` motions of ``length_deg`` between free configurations (like a planner's edges)."""
+    rng = np.random.default_rng(seed)
+    P = arrays.problem(CERT_MARGIN_M)
+    lo, hi = arrays.limits_deg[:, 0], arrays.limits_deg[:, 1]
+    qa, qb = [], []
+    while len(qa) < n:
+        a = rng.uniform(lo, hi)
+        d = rng.normal(size=a.shape)
+        b = np.clip(a + length_deg * d / np.linalg.norm(d), lo, hi)
+        if config_free(P, a, CERT_MARGIN_M) and config_free(P, b, CERT_MARGIN_M):
+            qa.append(a)
+            qb.append(b)
+    return np.array(qa), np.array(qb)
+
+
+def _best_per_call(fn, n: int, repeats: int = 7) -> float:
+    """Smallest time per call (µs) over ``repeats`` runs of ``fn`` (which makes ``n`` calls)."""
+    best = math.inf
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t)
+    return best / n * 1e6
+
+
+def motion_overhead(scenario, n: int = 500, length_deg: float = 10.0) -> dict[str, float]:
+    """Per-motion cost (µs) of the certified motion check: compiled alone, called from Python
+    and through OMPL, on the same ``n`` motions (see the module docstring)."""
+    from ompl import base as ob
+
+    a = scenario.arrays()
+    dof = a.links.shape[0]
+    qa, qb = _motions(a, n, length_deg)
+    P = a.problem(CERT_MARGIN_M)
+    expected = int(_edge_checks(P, qa, qb, CERT_MARGIN_M))
+    compiled = _best_per_call(lambda: _edge_checks(P, qa, qb, CERT_MARGIN_M), n)
+
+    fn = motion_free_at
+    buffer = pack_scenario(a, CERT_MARGIN_M)
+    counts = new_counts()
+    xa, xb = np.empty(dof), np.empty(dof)
+    args = (xa.ctypes.data, xb.ctypes.data, buffer.ctypes.data, counts.ctypes.data)
+
+    def from_python():
+        free = 0
+        for i in range(n):
+            xa[:] = qa[i]
+            xb[:] = qb[i]
+            free += fn(*args)
+        return free
+
+    assert from_python() == expected
+    from_python_us = _best_per_call(from_python, n)
+
+    space = ob.RealVectorStateSpace(dof)
+    bounds = ob.RealVectorBounds(dof)
+    for j in range(dof):
+        bounds.setLow(j, float(a.limits_deg[j, 0]))
+        bounds.setHigh(j, float(a.limits_deg[j, 1]))
+    space.setBounds(bounds)
+    states = []
+    for i in range(n):
+        s1, s2 = space.allocState(), space.allocState()
+        for j in range(dof):
+            s1[j], s2[j] = float(qa[i, j]), float(qb[i, j])
+        states.append((s1, s2))
+
+    def si_with(validator_of):
+        si = ob.SpaceInformation(space)
+        si.setStateValidityChecker(make_validity_callback(a))
+        si.setMotionValidator(validator_of(si))
+        si.setup()
+        return si
+
+    certified = si_with(lambda si: certified_motion_validator(si, space, a, CERT_MARGIN_M))
+
+    class Accept(ob.MotionValidator):
+        def checkMotion(self, s1, s2):  # noqa: N802
+            return True
+
+    trivial = si_with(Accept)
+
+    def via(si):
+        check = si.checkMotion
+        return sum(check(s1, s2) for s1, s2 in states)
+
+    assert via(certified) == expected
+    return {"dof": dof, "motions": n, "length_deg": length_deg, "free": expected,
+            "compiled_us": compiled, "from_python_us": from_python_us,
+            "via_ompl_us": _best_per_call(lambda: via(certified), n),
+            "dispatch_us": _best_per_call(lambda: via(trivial), n)}
+
+
+def test_certified_motion_validator_overhead(benchmark, scenario):
+    result = motion_overhead(scenario)
+    benchmark.pedantic(lambda: None, rounds=1, iterations=1)
+    benchmark.extra_info.update(result)
+    benchmark.extra_info["overhead_us"] = result["via_ompl_us"] - result["compiled_us"]
+
+
+@pytest.mark.parametrize("planner", ["RRT", "RRTConnect", "BITstar", "RRTConnect:sampled",
+                                     "BITstar:sampled"])
 def test_ompl_planner_50_seeds(benchmark, scenario, planner):
     plan_ompl(scenario, planner, seed=0)  # warm-up
     results = []
@@ -158,4 +283,25 @@ def test_ompl_planner_50_seeds(benchmark, scenario, planner):
         "cost_median_deg": float(np.median([r.cost_deg for r in ok])),
         "certified_fraction": float(np.mean([c.certified for c in checks])),
         "worst_penetration_m": float(max(c.penetration_m for c in checks)),
+        "found_uncertified": sum(r.found and not r.certified for r in results),
+        "motion_validator": results[0].params["motion_validator"],
+        "range_deg": results[0].params["range_deg"],
     })
+
+
+if __name__ == "__main__":
+    import os
+
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    files = sys.argv[1:] or [str(p) for p in (
+        __import__("pathlib").Path(__file__).resolve().parents[2] / "shared" / "scenarios"
+        / "paper-reference.toml",)]
+    print(f"load {os.getloadavg()[0]:.2f}")
+    for file in files:
+        r = motion_overhead(load_scenario(file))
+        print(f"{file}: " + ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}"
+                                      for k, v in r.items())
+              + f", overhead_us {r['via_ompl_us'] - r['compiled_us']:.3g}")
+    sys.stdout.flush()
+    os._exit(0)  # skip the ompl wheel's teardown noise (see tests/conftest.py)

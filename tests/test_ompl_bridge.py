@@ -1,4 +1,6 @@
-"""OMPL planners run as peers on our checker; their sampled edges are certified afterwards.
+"""OMPL planners run as peers on our checker: by default every motion goes through our certified
+edge check (``ompl:NAME``); with ``:sampled`` OMPL samples its motions and the path is certified
+afterwards.
 
 These tests need the optional 'ompl' extra and do not skip without it: CI installs it, and a
 skipped peer comparison is not a passed one.
@@ -21,7 +23,9 @@ from xfuzzy_rrt.geometry.collision import CERT_MARGIN_M
 from xfuzzy_rrt.geometry.path_check import certify_path
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.api import PLANNERS, check_planner, is_known_planner, plan_scenario
-from xfuzzy_rrt.planners.ompl_bridge import MISSING_EXTRA, make_validity_callback, plan_ompl
+from xfuzzy_rrt.planners.ompl_bridge import (COUNTS_WORK, DEFAULT_RANGE_DEG, MISSING_EXTRA,
+                                             certified_motion_validator, make_validity_callback,
+                                             parse_ompl_label, plan_ompl)
 from xfuzzy_rrt.planners.result import path_cost_deg
 
 SCENARIOS = (sorted((FIXTURES / "scenarios").glob("*.toml"))
@@ -29,6 +33,17 @@ SCENARIOS = (sorted((FIXTURES / "scenarios").glob("*.toml"))
              + [p for p in shared_scenarios() if p.stem == "paper-reference"])
 TWO_CIRCLES = FIXTURES / "scenarios" / "two-circles.toml"
 PEERS = ("ompl:RRT", "ompl:RRTConnect", "ompl:RRTstar", "ompl:BITstar")
+#: 2 joints, 5 joints, two arms of 3 joints.
+ARM_FIXTURES = (TWO_CIRCLES, FIXTURES / "arms" / "five-dof.toml",
+                FIXTURES / "arms" / "dual-3dof.toml")
+
+
+@pytest.fixture
+def untuned(monkeypatch):
+    """No tuned OMPL range (whatever the shipped files say): the 10-degree default applies."""
+    import xfuzzy_rrt.planners.tuned as tuned
+
+    monkeypatch.setattr(tuned, "tuned_params", lambda label: None)
 
 
 @pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
@@ -36,10 +51,12 @@ def test_ompl_paths_run_start_to_goal_exactly_and_certification_agrees_with_the_
     s = load_scenario(path)
     a = s.arrays()
     oracle = Oracle(path)
-    for planner in PEERS:
+    for planner in PEERS + ("ompl:RRTConnect:sampled",):
         for seed in range(4):
             r = plan_scenario(s, planner=planner, seed=seed)
             assert r.planner == planner and r.found, (planner, seed)
+            if not planner.endswith(":sampled"):
+                assert r.success, ("certified by construction", planner, seed)
             assert np.array_equal(r.path_deg[0], a.start_deg)
             assert np.array_equal(r.path_deg[-1], a.goal_deg)
             assert r.cost_deg == pytest.approx(path_cost_deg(r.path_deg))
@@ -61,8 +78,9 @@ def test_a_grazing_edge_that_ompl_samples_past_is_flagged_with_its_depth(tmp_pat
     # the extent (~25 deg): its samples at -36, -12, 12, 36 deg miss the box at 0 deg.
     file = thin_box(tmp_path)
     s = load_scenario(file)
-    r = plan_ompl(s, "ompl:RRT", seed=0, step_deg=1000.0, goal_bias=1.0,
+    r = plan_ompl(s, "ompl:RRT:sampled", seed=0, step_deg=1000.0, goal_bias=1.0,
                   validity_resolution=0.05)
+    assert r.params["motion_validator"] == "sampled"
     assert r.found and r.path_deg.tolist() == [[-60.0, 0.0], [60.0, 0.0]]
     assert not r.success and not r.certified, "a colliding path is never a success"
     assert Oracle(file).path_problems(r.path_deg), "the oracle sees the collision"
@@ -72,9 +90,91 @@ def test_a_grazing_edge_that_ompl_samples_past_is_flagged_with_its_depth(tmp_pat
     assert r.penetration_m == check.penetration_m and r.min_clearance_m == -r.penetration_m
     assert r.violation.startswith("segment 0 penetrates an obstacle 7 mm deep at q = (")
     # With a fine motion check OMPL itself refuses that edge and finds another way.
-    fine = plan_ompl(s, "ompl:RRT", seed=0, step_deg=1000.0, goal_bias=1.0,
+    fine = plan_ompl(s, "ompl:RRT:sampled", seed=0, step_deg=1000.0, goal_bias=1.0,
                      validity_resolution=0.001)
     assert not fine.success or len(fine.path_deg) > 2
+
+
+def test_the_certified_motion_check_refuses_the_edge_that_sampling_steps_over(tmp_path):
+    # The same straight motion, now checked by our certified edge check: refused, so the
+    # planner finds another way round or nothing, never the penetrating edge.
+    file = thin_box(tmp_path)
+    s = load_scenario(file)
+    for seed in range(5):
+        r = plan_ompl(s, "ompl:RRT", seed=seed, step_deg=1000.0, goal_bias=1.0, max_iter=2000)
+        assert r.params["motion_validator"] == "certified"
+        assert r.params["motions_checked"] > 0
+        assert r.success == r.found, "every path OMPL returns is certified"
+        if r.found:
+            assert len(r.path_deg) > 2 and Oracle(file).path_problems(r.path_deg) == []
+
+
+def test_the_certified_motion_validator_agrees_with_segment_free(tmp_path):
+    from ompl import base as ob
+
+    from xfuzzy_rrt.geometry.collision import segment_free
+
+    for file in (thin_box(tmp_path), FIXTURES / "arms" / "five-dof.toml",
+                 FIXTURES / "arms" / "dual-2dof.toml"):
+        a = load_scenario(file).arrays()
+        dof = a.links.shape[0]
+        space = ob.RealVectorStateSpace(dof)
+        bounds = ob.RealVectorBounds(dof)
+        for j in range(dof):
+            bounds.setLow(j, float(a.limits_deg[j, 0]))
+            bounds.setHigh(j, float(a.limits_deg[j, 1]))
+        space.setBounds(bounds)
+        si = ob.SpaceInformation(space)
+        si.setStateValidityChecker(make_validity_callback(a))
+        counts = np.zeros(4, dtype=np.int64)
+        si.setMotionValidator(certified_motion_validator(si, space, a, CERT_MARGIN_M, counts))
+        si.setup()
+        s1, s2 = space.allocState(), space.allocState()
+        rng = np.random.default_rng(11)
+        verdicts = []
+        for _ in range(300):
+            qa, qb = rng.uniform(a.limits_deg[:, 0], a.limits_deg[:, 1], size=(2, dof))
+            qb = qa + rng.uniform(0.0, 1.0) * (qb - qa)  # short and long motions
+            for j in range(dof):
+                s1[j], s2[j] = float(qa[j]), float(qb[j])
+            ours = bool(si.checkMotion(s1, s2))
+            assert ours == segment_free(a, qa, qb), (file, qa, qb)
+            verdicts.append(ours)
+        assert 0 < sum(verdicts) < len(verdicts), file  # both verdicts were exercised
+        assert counts[1] == len(verdicts) and counts[2] == len(verdicts) - sum(verdicts)
+
+
+def test_where_sampling_penetrates_the_certified_validator_returns_only_certified_paths():
+    # On two-circles OMPL's sampled motion check lets RRTConnect graze a circle on several
+    # seeds; through the certified check every path is certified, on every seed.
+    s = load_scenario(TWO_CIRCLES)
+    oracle = Oracle(TWO_CIRCLES)
+    sampled = [plan_scenario(s, planner="ompl:RRTConnect:sampled", seed=k) for k in range(20)]
+    assert any(r.found and not r.certified and r.penetration_m > 0.0 for r in sampled)
+    for seed in range(20):
+        r = plan_scenario(s, planner="ompl:RRTConnect", seed=seed)
+        assert r.found and r.certified and r.success, seed
+        assert oracle.path_problems(r.path_deg) == [], seed
+
+
+@pytest.mark.parametrize("path", ARM_FIXTURES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("planner", ["ompl:RRTConnect", "ompl:BITstar"])
+def test_rrtconnect_and_bitstar_solve_two_joints_five_joints_and_two_arms(path, planner):
+    s = load_scenario(path)
+    a = s.arrays()
+    for seed in range(5):
+        r = plan_scenario(s, planner=planner, seed=seed)
+        assert r.success, (planner, seed, r.params.get("stopped_by"))
+        assert np.array_equal(r.path_deg[0], a.start_deg)
+        assert np.array_equal(r.path_deg[-1], a.goal_deg)
+        again = plan_scenario(s, planner=planner, seed=seed)
+        assert np.array_equal(again.path_deg, r.path_deg)
+        for key in ("motions_checked", "state_checks", "work"):
+            assert again.params[key] == r.params[key], key
+        if COUNTS_WORK:  # the problem bundle counts distance evaluations (interfaces.md 1)
+            assert r.params["work"] > 0
+        else:
+            assert r.params["work"] is None
 
 
 def test_the_same_seed_repeats_the_run_and_other_seeds_differ():
@@ -92,8 +192,8 @@ def test_rrt_iterations_counted_by_the_termination_condition_equal_rrtstar_own_c
     # as RRT until the first solution, and it counts its iterations itself.
     s = load_scenario(TWO_CIRCLES)
     for seed in range(5):
-        rrt = plan_scenario(s, planner="ompl:RRT", seed=seed)
-        star = plan_scenario(s, planner="ompl:RRTstar", seed=seed)
+        rrt = plan_scenario(s, planner="ompl:RRT:range=10", seed=seed)
+        star = plan_scenario(s, planner="ompl:RRTstar:range=10", seed=seed)
         assert rrt.params["iterations_source"] == "termination-condition evaluations"
         assert star.params["iterations_source"] == "numIterations"
         assert rrt.iterations == star.iterations and rrt.nodes == star.nodes
@@ -106,15 +206,102 @@ def test_the_iteration_budget_ends_a_run_as_a_failure():
     assert r.path_deg.shape == (0, 2) and r.params["stopped_by"] == "max_iter"
 
 
-def test_settings_are_ours_and_recorded():
+def test_settings_are_ours_and_recorded(untuned):
     s = load_scenario(TWO_CIRCLES)
     r = plan_scenario(s, planner="ompl:RRT", seed=1)
     p = r.params
-    assert p["range_deg"] == 10.0 and p["goal_bias"] == 0.05 and p["margin_m"] == CERT_MARGIN_M
-    assert p["validity_resolution_deg"] == pytest.approx(0.01 * np.hypot(360.0, 360.0))
+    assert p["range_deg"] == DEFAULT_RANGE_DEG == 10.0 and p["range_source"] == "default"
+    assert p["goal_bias"] == 0.05 and p["margin_m"] == CERT_MARGIN_M
+    assert p["motion_validator"] == "certified" and p["validity_resolution_deg"] is None
+    assert p["motions_checked"] > 0 and p["state_checks"] > 0
+    sampled = plan_scenario(s, planner="ompl:RRT:sampled", seed=1).params
+    assert sampled["motion_validator"] == "sampled"
+    assert sampled["validity_resolution_deg"] == pytest.approx(0.01 * np.hypot(360.0, 360.0))
     bit = plan_scenario(s, planner="ompl:BITstar", seed=1).params
     assert bit["range_deg"] is None and bit["goal_bias"] is None  # BIT* has neither
+    assert bit["range_source"] is None
     json.dumps(r.to_json_dict())  # plain types only
+
+
+def test_the_range_comes_from_the_label_else_the_tuned_file_else_ten_degrees(monkeypatch):
+    import xfuzzy_rrt.planners.tuned as tuned
+
+    asked = []
+
+    def fake(label):
+        asked.append(label)
+        return {"range_deg": 42.0} if label == "ompl:RRTConnect" else None
+
+    monkeypatch.setattr(tuned, "tuned_params", fake)
+    s = load_scenario(TWO_CIRCLES)
+    cases = {"ompl:RRTConnect": (42.0, "tuned"), "ompl:RRTConnect:sampled": (42.0, "tuned"),
+             "ompl:RRTConnect:range=60": (60.0, "label"),
+             "ompl:RRTConnect:sampled:range=60": (60.0, "label"),
+             "ompl:RRTConnect:range=7.5:sampled": (7.5, "label"),
+             "ompl:RRT": (10.0, "default")}
+    for label, (range_deg, source) in cases.items():
+        r = plan_scenario(s, planner=label, seed=3)
+        assert (r.params["range_deg"], r.params["range_source"]) == (range_deg, source), label
+        assert r.planner == label
+        assert r.params["motion_validator"] == ("sampled" if ":sampled" in label else
+                                                "certified")
+    assert "ompl:RRTConnect" in asked and not any(":" in a[len("ompl:"):] for a in asked)
+    # The label's range is the range OMPL used: same run as the explicit argument.
+    by_label = plan_scenario(s, planner="ompl:RRTConnect:range=60", seed=3)
+    by_argument = plan_ompl(s, "ompl:RRTConnect", seed=3, step_deg=60.0)
+    assert by_argument.params["range_source"] == "argument"
+    assert np.array_equal(by_label.path_deg, by_argument.path_deg)
+
+
+def test_label_options_parse_in_any_order():
+    assert parse_ompl_label("ompl:RRTConnect").sampled is False
+    spec = parse_ompl_label("ompl:RRTConnect:sampled:range=60")
+    assert (spec.name, spec.sampled, spec.range_deg, spec.base) == (
+        "RRTConnect", True, 60.0, "ompl:RRTConnect")
+    other = parse_ompl_label("ompl:RRTConnect:range=60:sampled")
+    assert (other.name, other.sampled, other.range_deg) == ("RRTConnect", True, 60.0)
+    assert parse_ompl_label("RRT:range=1e3").range_deg == 1000.0
+    assert check_planner("ompl:BITstar:sampled") == "ompl:BITstar:sampled"
+
+
+def test_a_planner_that_needs_the_last_valid_state_runs_only_sampled(monkeypatch):
+    # PDST reads the last valid state of a refused motion, which a Python motion validator
+    # cannot write: certified by construction is impossible, so only ':sampled' is accepted.
+    # (The 2.0.1 wheel does not expose PDST; a wheel that does must not run it certified.)
+    import xfuzzy_rrt.planners.ompl_bridge as bridge
+
+    names = bridge.ompl_planner_names()
+    monkeypatch.setattr(bridge, "ompl_planner_names", lambda where="--planners": names + ("PDST",))
+    with pytest.raises(InputError, match=r"'PDST' cannot run with the certified motion check: "
+                                         r".*use ompl:PDST:sampled"):
+        parse_ompl_label("ompl:PDST")
+    assert parse_ompl_label("ompl:PDST:sampled").sampled
+
+
+@pytest.mark.parametrize("label, message", [
+    ("ompl:RRTConnect:fast", r"unknown option 'fast' in 'ompl:RRTConnect:fast' \(options: "
+                             r"sampled, range=DEG\)"),
+    ("ompl:RRTConnect:", r"unknown option '' in"),
+    ("ompl:RRTConnect:sampled=1", r"unknown option 'sampled=1'"),
+    ("ompl:RRTConnect:range", r"range must be a positive number of degrees \(range=DEG\)"),
+    ("ompl:RRTConnect:range=abc", r"range must be a positive number .* got 'abc'"),
+    ("ompl:RRTConnect:range=-5", r"range must be a positive number .* got '-5'"),
+    ("ompl:RRTConnect:range=0", r"got '0'"),
+    ("ompl:RRTConnect:range=nan", r"got 'nan'"),
+    ("ompl:RRTConnect:range=inf", r"got 'inf'"),
+    ("ompl:RRTConnect:sampled:sampled", r"option 'sampled' given twice"),
+    ("ompl:RRTConnect:range=5:range=6", r"option 'range' given twice"),
+    ("ompl:BITstar:range=60", r"OMPL planner 'BITstar' has no range"),
+    ("ompl:Nope:sampled", r"unknown OMPL planner 'Nope'"),
+])
+def test_bad_label_options_are_one_input_error_naming_the_option(label, message, capsys):
+    with pytest.raises(InputError, match=message) as info:
+        check_planner(label)
+    assert info.value.where == "--planners"
+    code = main(["plan", str(TWO_CIRCLES), "--planner", label])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == ""
+    assert err.startswith("error: --planner: ") and err.count("\n") == 1, err
 
 
 def test_the_validity_callback_is_our_checker():
@@ -175,12 +362,15 @@ def test_without_the_extra_the_console_script_prints_one_error_line(tmp_path, mo
 
 
 def test_cli_plan_with_an_ompl_planner_repeats_across_processes(run_cli):
-    # Seed 4 grazes an obstacle: the same uncertified path, exit code and message each time.
+    # Seed 4 grazes an obstacle with OMPL's sampled check: the same uncertified path, exit code
+    # and message each time.
     runs = []
     for _ in range(2):
-        proc = run_cli("plan", TWO_CIRCLES, "--planner", "ompl:RRTConnect", "--seed", "4")
+        proc = run_cli("plan", TWO_CIRCLES, "--planner", "ompl:RRTConnect:sampled", "--seed",
+                       "4")
         assert proc.returncode == 1, proc.stderr
-        assert proc.stderr == (f"not certified: {TWO_CIRCLES}: ompl:RRTConnect seed 4: segment "
+        assert proc.stderr == (f"not certified: {TWO_CIRCLES}: ompl:RRTConnect:sampled seed 4: "
+                               "segment "
                                "38 penetrates an obstacle 0.03163 mm deep at q = (129.996, "
                                "-96.6686) deg\n")
         data = json.loads(proc.stdout)
@@ -189,8 +379,19 @@ def test_cli_plan_with_an_ompl_planner_repeats_across_processes(run_cli):
         data.pop("wall_s")
         runs.append(data)
     assert runs[0] == runs[1]
-    assert runs[0]["planner"] == "ompl:RRTConnect" and runs[0]["params"]["ompl_seed"] == 5
+    assert runs[0]["planner"] == "ompl:RRTConnect:sampled"
+    assert runs[0]["params"]["ompl_seed"] == 5
     assert runs[0]["path_deg"][0] == [-120.0, 30.0] and runs[0]["path_deg"][-1] == [150.0, -60.0]
+    # The same seed through the certified check: a certified path, exit 0, twice the same.
+    certified = []
+    for _ in range(2):
+        proc = run_cli("plan", TWO_CIRCLES, "--planner", "ompl:RRTConnect", "--seed", "4")
+        assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+        data = json.loads(proc.stdout)
+        assert data["success"] is True and data["params"]["motion_validator"] == "certified"
+        data.pop("wall_s")
+        certified.append(data)
+    assert certified[0] == certified[1]
 
 
 def test_a_pytest_run_that_plans_with_bitstar_ends_without_nanobind_leak_lines():
@@ -209,3 +410,16 @@ def test_a_pytest_run_that_plans_with_bitstar_ends_without_nanobind_leak_lines()
                               test, "-k", "no_such_test"], capture_output=True, text=True,
                              timeout=300, cwd=PROJECT)
     assert failing.returncode == 5  # "no tests collected": the real exit status survives
+
+
+def test_the_compiled_checks_are_ready_at_import_not_compiled_inside_a_timed_solve():
+    # Compiling inside OMPL's solve() would spend the first plan's wall-clock cap on numba.
+    import subprocess
+
+    code = ("import os, xfuzzy_rrt.planners.ompl_bridge as b; "
+            "print(len(b.state_free_at.overloads), len(b.motion_free_at.overloads), flush=True); "
+            "os._exit(0)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=600, cwd=PROJECT)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["1", "1"]

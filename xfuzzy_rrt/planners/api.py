@@ -109,10 +109,11 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
 
     ``rulebook`` (fuzzy-rrt only) is a loaded rulebook, a directory path, or ``None`` for the
     shipped default, or for the one a ``fuzzy-rrt:NAME`` label names. ``step_deg``/``goal_bias``
-    configure plain RRT and the OMPL planners (range and goal bias where they have one);
-    Fuzzy-RRT takes both from its rulebook. ``ompl:NAME`` runs OMPL's geometric planner NAME
-    with our collision checker (:func:`xfuzzy_rrt.planners.ompl_bridge.plan_ompl`; needs the
-    optional 'ompl' extra). The result's ``planner`` is the label. ``clearance_m``: the
+    configure plain RRT; ``goal_bias`` also the OMPL planners that have one. Fuzzy-RRT takes both
+    from its rulebook. ``ompl:NAME[:sampled][:range=DEG]`` runs OMPL's geometric planner NAME
+    with our collision checker and, unless ``:sampled``, our certified edge check; its range is
+    the label's, else the tuned one (:func:`xfuzzy_rrt.planners.ompl_bridge.plan_ompl`; needs
+    the optional 'ompl' extra). The result's ``planner`` is the label. ``clearance_m``: the
     certified clearance in metres (default: the scenario's ``clearance_m``, else 0).
     ``max_time_s``: a wall-clock budget on top of ``max_iter`` (whichever ends first;
     :mod:`xfuzzy_rrt.planners.termination`).
@@ -144,8 +145,9 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
         return replace_result(result, planner=spec.label)
     from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 
-    return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, step_deg=step_deg,
-                     goal_bias=goal_bias, clearance_m=clearance_m, time_limit_s=max_time_s)
+    # OMPL's range comes from the label (ompl:NAME:range=DEG) or the tuned file, not step_deg.
+    return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, goal_bias=goal_bias,
+                     clearance_m=clearance_m, time_limit_s=max_time_s)
 
 
 def _tuned_rrt(where: str) -> dict[str, float]:

@@ -674,6 +674,7 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
         a, margin, exact, scenario=scenario.name, planner=spec.label, seed=int(seed),
         iterations=iterations, nodes=n, cost_deg=path_cost_deg(path) if exact else None,
         wall_s=wall, path_deg=path, tree_nodes_deg=tree, tree_parent=parent, params=params,
+        work=params["work"],
     )
     # Kept in params too for readers of older result files; the top-level fields are the truth.
     params["certified"] = result.certified if exact else None

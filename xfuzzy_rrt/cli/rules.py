@@ -15,6 +15,8 @@ from typing import List, Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option
+
 app = typer.Typer(help="Inspect, validate, evaluate and convert rulebooks.", no_args_is_help=True)
 
 
@@ -277,9 +279,9 @@ def coverage(
     sources: List[Path] = typer.Argument(..., help="Scenario TOML files or directories (planned "
                                          "--runs times each), or saved trace files (.parquet/.csv)."),
     runs: int = typer.Option(10, "--runs", min=1, help="Runs per scenario (seeds seed..seed+runs-1)."),
-    seed: int = typer.Option(0, "--seed", help="First seed."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="First seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run."),
-    workers: int = typer.Option(1, "--workers", min=1, help="Worker processes."),
+    workers: int = typer.Option(1, "--workers", callback=check_workers_option, min=1, help="Worker processes."),
     out: Optional[Path] = typer.Option(None, "--out", help="CSV: one row per FIS and rule (3,750 rows at 2 DOF)."),
     html: Optional[Path] = typer.Option(None, "--html", help="HTML page with 25x25 heatmaps per FIS."),
     top: int = typer.Option(5, "--top", min=0, help="Rules to list per FIS (largest output mass)."),
@@ -343,7 +345,7 @@ def diff(
     out: Optional[Path] = typer.Option(None, "--out", help="CSV of every changed cell."),
     limit: int = typer.Option(50, "--limit", min=0, help="Changed cells to print per FIS."),
     replay: Optional[Path] = typer.Option(None, "--replay", help="Scenario to plan with both rulebooks."),
-    seed: int = typer.Option(0, "--seed", help="Seed for --replay."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Seed for --replay."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget for --replay."),
 ) -> int:
     """Exit 0 when A and B behave identically, 1 when they differ (differences on stdout)."""
@@ -445,7 +447,7 @@ def simplify_cmd(
                                          "(mean iterations over --scenario x --seeds)."),
     scenario: Optional[List[Path]] = typer.Option(None, "--scenario", help="Scenario for the budget check (repeatable)."),
     seeds: int = typer.Option(10, "--seeds", min=1, help="Seeds per scenario for the budget check."),
-    seed: int = typer.Option(0, "--seed", help="First seed of the budget check."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="First seed of the budget check."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run."),
     levels: Optional[int] = typer.Option(None, "--levels", help="Round constants to K levels per FIS (lossy)."),
     tolerance: Optional[float] = typer.Option(None, "--tolerance", help="Merge rules whose constants differ "
@@ -454,7 +456,7 @@ def simplify_cmd(
                                          "their neighbours' values (lossy)."),
     strict: bool = typer.Option(False, "--strict", help="Require loss + 1.645 standard errors "
                                 "(paired over seeds) to be within the budget, not just the mean."),
-    workers: int = typer.Option(1, "--workers", min=1, help="Worker processes for the budget runs."),
+    workers: int = typer.Option(1, "--workers", callback=check_workers_option, min=1, help="Worker processes for the budget runs."),
     holdout_seeds: Optional[int] = typer.Option(None, "--holdout-seeds", min=1, help="Fresh seeds per scenario (never searched on) to re-measure a lossy result's loss (default: --seeds)."),
 ) -> int:
     """Fewest 'any' rules with the same constants; lossy steps only within a stated budget."""

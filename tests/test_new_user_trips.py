@@ -1,0 +1,160 @@
+"""What a new user tripped on (issue 22, "tried as a new user would"): each test is one trip.
+
+Every bad input is one ``error: ...`` line and exit 2 before any planning; a run that finds
+nothing says so on stderr; explain finds the rulebook that made a trace by itself.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import FIXTURES, PROJECT
+
+SCENARIO = FIXTURES / "scenarios" / "boxes-and-circle.toml"
+FIVE_DOF = FIXTURES / "arms" / "five-dof.toml"
+
+
+def _one_error_line(proc, *needles: str) -> str:
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), proc.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+    return lines[0]
+
+
+def _edited_copy(tmp_path: Path, name: str = "e") -> Path:
+    """``cp -r rulebooks/goal-frame e`` and change one rule's step: the user's own rulebook
+    that still carries the name ``goal-frame``."""
+    dest = tmp_path / name
+    shutil.copytree(PROJECT / "rulebooks" / "goal-frame", dest)
+    fis = dest / "step_deg.fis"
+    text = fis.read_text()
+    old = "then step_deg = 27.944961822793296"
+    assert old in text
+    fis.write_text(text.replace(old, "then step_deg = 20.0", 1))
+    return dest
+
+
+# ------------------------------------------------------------------ 1. explain finds its rulebook
+
+
+def test_explain_finds_the_edited_rulebook_that_made_the_trace(run_cli, tmp_path):
+    rb = _edited_copy(tmp_path)
+    trace = tmp_path / "t.parquet"
+    plan = run_cli("plan", SCENARIO, "--rulebook", rb, "--trace", trace, "--max-iter", "300",
+                   "--out", tmp_path / "r.json")
+    assert plan.returncode in (0, 1), plan.stderr
+    proc = run_cli("explain", trace, "--iteration", "2")
+    assert proc.returncode == 0, proc.stderr
+    assert "goal-frame" in proc.stdout or proc.stdout.strip()
+    # the JSON result finds it too
+    proc = run_cli("explain", tmp_path / "r.json", "--iteration", "2")
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_explain_names_the_changed_rulebook_directory_and_accepts_an_override(run_cli, tmp_path):
+    rb = _edited_copy(tmp_path)
+    trace = tmp_path / "t.csv"
+    plan = run_cli("plan", SCENARIO, "--rulebook", rb, "--trace", trace, "--max-iter", "300",
+                   "--out", tmp_path / "r.json")
+    assert plan.returncode in (0, 1), plan.stderr
+    kept = tmp_path / "kept"
+    shutil.copytree(rb, kept)  # the version that made the trace, elsewhere
+    fis = rb / "step_deg.fis"
+    fis.write_text(fis.read_text().replace("then step_deg = 20.0", "then step_deg = 21.0", 1))
+    line = _one_error_line(run_cli("explain", trace, "--iteration", "2"), str(rb.resolve()),
+                           "changed", "--rulebook")
+    assert "--rulebook:" not in line  # the user passed no --rulebook: it is not blamed
+    _one_error_line(run_cli("explain", tmp_path / "r.json", "--iteration", "2"),
+                    str(rb.resolve()), "changed")
+    assert run_cli("explain", trace, "--iteration", "2", "--rulebook", kept).returncode == 0
+    shutil.rmtree(rb)
+    _one_error_line(run_cli("explain", trace, "--iteration", "2"), str(rb.resolve()),
+                    "no longer exists")
+
+
+# ------------------------------------------------------------------ 2. seeds out of range
+
+
+@pytest.mark.parametrize("seed", ["18446744073709551616", "99999999999999999999999", "-1"])
+@pytest.mark.parametrize("command", [
+    ["plan", str(SCENARIO), "--max-iter", "5"],
+    ["bench", str(SCENARIO), "--runs", "1", "--max-iter", "5"],
+    ["train", "--scenario", str(SCENARIO), "--generations", "1", "--out", "rb"],
+    ["rules", "coverage", str(PROJECT / "rulebooks" / "goal-frame"), str(SCENARIO)],
+])
+def test_a_seed_out_of_range_is_one_line_naming_seed_and_the_range(run_cli, tmp_path, command,
+                                                                   seed):
+    proc = run_cli(*command, "--seed", seed, cwd=tmp_path)
+    _one_error_line(proc, "--seed", "9223372036854775807")
+    assert not any(tmp_path.iterdir())
+
+
+def test_the_seeds_of_a_bench_must_all_fit_in_the_seed_range(run_cli, tmp_path):
+    proc = run_cli("bench", SCENARIO, "--runs", "10", "--seed", str(2**63 - 5),
+                   "--out", tmp_path / "b")
+    _one_error_line(proc, "--seed", "10 run seeds")
+    assert not (tmp_path / "b").exists()
+
+
+def test_the_largest_seed_plans(run_cli):
+    proc = run_cli("plan", SCENARIO, "--seed", str(2**63 - 1), "--max-iter", "20",
+                   "--planner", "rrt")
+    assert proc.returncode in (0, 1), proc.stderr
+    assert json.loads(proc.stdout)["seed"] == 2**63 - 1
+
+
+# ------------------------------------------------------------------ 3. exit 1 says why
+
+
+def test_plan_that_finds_no_path_says_so_in_one_stderr_line_and_still_writes_out(run_cli, tmp_path):
+    out = tmp_path / "o.json"
+    proc = run_cli("plan", SCENARIO, "--planner", "rrt", "--max-iter", "2", "--out", out)
+    assert proc.returncode == 1
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert "no path" in lines[0] and "within 2 iterations" in lines[0] and str(out) in lines[0]
+    assert json.loads(out.read_text())["found"] is False
+
+
+# ------------------------------------------------------------------ 4. lists, workers, rulebook
+
+
+def test_an_empty_entry_in_planners_is_refused(run_cli, tmp_path):
+    proc = run_cli("bench", SCENARIO, "--planners", "rrt,,fuzzy-rrt", "--out", tmp_path / "b")
+    _one_error_line(proc, "--planners", "empty")
+    assert not (tmp_path / "b").exists()
+
+
+@pytest.mark.parametrize("command", [["bench", str(SCENARIO), "--runs", "1"],
+                                     ["train", "--scenario", str(SCENARIO), "--out", "rb"]])
+def test_an_absurd_number_of_workers_is_refused_naming_the_cap(run_cli, tmp_path, command):
+    proc = run_cli(*command, "--workers", "100000", cwd=tmp_path)
+    _one_error_line(proc, "--workers", "100000", "at most")
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_rulebook_given_to_a_planner_without_rules_is_refused(run_cli, tmp_path):
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    _one_error_line(run_cli("plan", SCENARIO, "--planner", "rrt", "--rulebook", broken),
+                    "--rulebook", "rrt")
+    _one_error_line(run_cli("bench", SCENARIO, "--planners", "rrt", "--rulebook", broken,
+                            "--out", tmp_path / "b"), "--rulebook")
+    assert not (tmp_path / "b").exists()
+
+
+# ------------------------------------------------------------------ 5. DOF mismatch up front
+
+
+def test_bench_finds_a_rulebook_dof_mismatch_before_any_planning(run_cli, tmp_path):
+    proc = run_cli("bench", SCENARIO, FIVE_DOF, "--planners", "rrt,fuzzy-rrt", "--runs", "2",
+                   "--out", tmp_path / "b")
+    _one_error_line(proc, "five-dof", "DOF")
+    assert "bench:" not in proc.stderr  # no progress line: nothing ran
+    assert not (tmp_path / "b").exists()

@@ -7,6 +7,7 @@ nothing says so on stderr; explain finds the rulebook that made a trace by itsel
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -158,3 +159,47 @@ def test_bench_finds_a_rulebook_dof_mismatch_before_any_planning(run_cli, tmp_pa
     _one_error_line(proc, "five-dof", "DOF")
     assert "bench:" not in proc.stderr  # no progress line: nothing ran
     assert not (tmp_path / "b").exists()
+
+
+# ------------------------------------------------------------------ 6. rules diff
+
+
+def _scale_constants(fis: Path, output: str, factor: float) -> None:
+    text = fis.read_text()
+    new, n = re.subn(rf"(then {output} = )(\S+)$",
+                     lambda m: f"{m.group(1)}{float(m.group(2)) * factor!r}", text, flags=re.M)
+    assert n > 0
+    fis.write_text(new)
+
+
+def test_replay_whose_plans_never_differ_says_the_plans_are_identical(run_cli, tmp_path):
+    b = tmp_path / "b"
+    shutil.copytree(PROJECT / "rulebooks" / "expert", b)
+    _scale_constants(b / "goal_bias.fis", "goal_bias", 1 - 1e-9)  # decisions move, plans do not
+    proc = run_cli("rules", "diff", PROJECT / "rulebooks" / "expert", b, "--replay",
+                   PROJECT / "xfuzzy_rrt" / "data" / "scenarios" / "demo-tissue.toml",
+                   "--max-iter", "300")
+    assert proc.returncode == 1, proc.stderr
+    assert "first divergence at iteration 1" in proc.stdout
+    assert "iteration None" not in proc.stdout
+    assert "the plans are identical" in proc.stdout
+
+
+def test_rules_diff_against_the_fll_round_trip_is_a_compact_summary(run_cli, tmp_path):
+    a = PROJECT / "rulebooks" / "goal-frame"
+    assert run_cli("rules", "export", a, "--out", tmp_path / "fll").returncode == 0
+    assert run_cli("rules", "import", tmp_path / "fll", "--out", tmp_path / "rt").returncode == 0
+    proc = run_cli("rules", "diff", a, tmp_path / "rt")
+    assert proc.returncode == 0, proc.stderr
+    assert len(proc.stdout) < 3000, proc.stdout
+    assert not re.search(r"\bnan\b", proc.stdout), proc.stdout
+    assert "only in a (absent in b)" in proc.stdout
+
+
+def test_rules_diff_summarises_constants_that_differ_only_by_float_rounding(run_cli, tmp_path):
+    b = tmp_path / "b"
+    shutil.copytree(PROJECT / "rulebooks" / "expert", b)
+    _scale_constants(b / "goal_bias.fis", "goal_bias", 1 - 3e-16)
+    proc = run_cli("rules", "diff", PROJECT / "rulebooks" / "expert", b)
+    assert "differ only by float rounding" in proc.stdout, proc.stdout
+    assert not any(line.startswith("  r") for line in proc.stdout.splitlines()), proc.stdout

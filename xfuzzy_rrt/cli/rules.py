@@ -337,6 +337,44 @@ def coverage(
 # ---------------------------------------------------------------------- analysis: diff
 
 
+def _short(value, width: int = 72) -> str:
+    """A value in at most ``width`` characters (long lists and texts say how long they are)."""
+    text = repr(value)
+    if len(text) <= width:
+        return text
+    size = f"{len(value)} items" if isinstance(value, (list, tuple)) else f"{len(text)} chars"
+    return f"{text[:width - 20]}... ({size})"
+
+
+def _documentary_lines(doc, limit: int) -> list[str]:
+    """Documentary differences, compact: changed values shortened, keys that only one side has
+    listed by name on one line per side (an FLL round trip drops the whole provenance)."""
+    from xfuzzy_rrt.analysis.diff import ABSENT
+
+    lines = []
+    only = {"a": [], "b": []}
+    changed = []
+    for f in doc.itertuples(index=False):
+        if f.b is ABSENT:
+            only["a"].append(f.field)
+        elif f.a is ABSENT:
+            only["b"].append(f.field)
+        else:
+            changed.append(f)
+    for f in changed[:limit]:
+        lines.append(f"note: {f.field}: {_short(f.a)} -> {_short(f.b)}")
+    if len(changed) > limit:
+        lines.append(f"note: ... and {len(changed) - limit} more documentary differences "
+                     "(--limit, --html)")
+    for side, other in (("a", "b"), ("b", "a")):
+        keys = only[side]
+        if keys:
+            shown = ", ".join(keys[:limit]) + (f", ... ({len(keys) - limit} more)"
+                                               if len(keys) > limit else "")
+            lines.append(f"note: {len(keys)} key(s) only in {side} (absent in {other}): {shown}")
+    return lines
+
+
 @app.command("diff")
 def diff(
     a: Path = typer.Argument(..., help="Rulebook directory A."),
@@ -366,6 +404,10 @@ def diff(
             lines.append(f"{row.output}: {row.cells_changed} cells changed "
                          f"(max |b - a| {row.max_abs_delta:.6g}), {row.peaks_moved} peaks moved")
             g = d.cells[d.cells["output"] == row.output]
+            if row.cells_rounding_only:
+                lines.append(f"  {row.cells_rounding_only} of them differ only by float rounding "
+                             "(<= 1e-12 relative; listed with --out)")
+                g = g[~d.rounding_mask(g)]
             for c in g.head(limit).itertuples(index=False):
                 lines.append(f"  r{c.rule}: {c.a!r} -> {c.b!r} ({c.delta:+.6g})  if {c.antecedent}")
             if len(g) > limit:
@@ -374,10 +416,7 @@ def diff(
                 lines.append(f"  peak {p.input}.{p.term}: {p.a!r} -> {p.b!r} ({p.shift:+.6g})")
     if d.bounds_mode:
         lines.append(f"bounds mode: {d.bounds_mode[0]} -> {d.bounds_mode[1]}")
-    for f in d.documentary.head(limit).itertuples(index=False):
-        lines.append(f"note: {f.field}: {f.a!r} -> {f.b!r}")
-    if len(d.documentary) > limit:
-        lines.append(f"note: ... and {len(d.documentary) - limit} more documentary differences (--limit, --html)")
+    lines.extend(_documentary_lines(d.documentary, limit))
     rep = None
     if scenario is not None:
         rep = replay_diff(scenario, ra, rb, seed=seed, max_iter=max_iter)
@@ -385,9 +424,12 @@ def diff(
         if rep.divergence is None:
             lines.append(f"  no divergence: identical decisions in all {rep.result_a.iterations} iterations")
         else:
+            plan_note = (f"the plan itself (sample, outcome) first differs at iteration "
+                         f"{rep.plan_divergence}" if rep.plan_divergence is not None else
+                         "the plans are identical (same samples, outcomes and nodes in all "
+                         f"{rep.result_a.iterations} iterations)")
             lines.append(f"  first divergence at iteration {rep.divergence} (decisions before it "
-                         "identical); the plan itself (sample, outcome) first differs at "
-                         f"iteration {rep.plan_divergence}")
+                         f"identical); {plan_note}")
             for q in rep.decisions.itertuples(index=False):
                 lines.append(f"    {q.quantity}: {q.a} | {q.b}")
             for c in rep.causes.itertuples(index=False):

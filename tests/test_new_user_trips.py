@@ -203,3 +203,33 @@ def test_rules_diff_summarises_constants_that_differ_only_by_float_rounding(run_
     proc = run_cli("rules", "diff", PROJECT / "rulebooks" / "expert", b)
     assert "differ only by float rounding" in proc.stdout, proc.stdout
     assert not any(line.startswith("  r") for line in proc.stdout.splitlines()), proc.stdout
+
+
+# ------------------------------------------------------------------ 8. robustness moving: why
+
+
+def test_moving_obstacles_with_replanning_say_why_runs_failed():
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.robustness.moving import FAILURE_CAUSES, diagnosis, moving_obstacles
+
+    s = load_scenario(FIXTURES / "scenarios" / "two-circles.toml")
+    table = moving_obstacles([s], ["rrt"], [0.02], joint_speed_deg_s=20.0, rate_hz=10.0,
+                             replan=True, runs=4, max_iter=500, time_limit_s=10.0)
+    row = table.iloc[0]
+    assert row["success_rate"] < 1 and row["replan_failures"] > 0  # the case under test
+    assert sum(int(row[c]) for c in FAILURE_CAUSES) == row["replan_failures"]
+    failed = row["runs"] - round(row["success_rate"] * row["runs"])
+    assert row["runs_unplanned"] + row["runs_collided"] + row["runs_timed_out"] == failed
+    why = diagnosis(row)
+    assert why is not None and f"{failed} of 4 runs failed" in why
+    assert f"{int(row['replan_failures'])} replannings found no path" in why
+    assert "no path within 500 iterations" in why or "in collision" in why
+
+
+def test_robustness_moving_prints_the_diagnosis_line(run_cli):
+    proc = run_cli("robustness", "moving", FIXTURES / "scenarios" / "two-circles.toml",
+                   "--planners", "rrt", "--speed", "0.02", "--replan", "--runs", "2",
+                   "--max-iter", "500", "--time-limit", "5", "--joint-speed", "20", "--rate", "10")
+    assert proc.returncode == 0, proc.stderr
+    why = [line for line in proc.stdout.splitlines() if line.strip().startswith("why:")]
+    assert len(why) == 1 and "runs failed" in why[0], proc.stdout

@@ -241,7 +241,7 @@ def moving_cmd(
     from xfuzzy_rrt.cli.common import load_scenario_warn
     from xfuzzy_rrt.errors import InputError
     from xfuzzy_rrt.planners.api import check_planner
-    from xfuzzy_rrt.robustness.moving import moving_obstacles
+    from xfuzzy_rrt.robustness.moving import diagnosis, moving_obstacles
 
     speeds = _floats(speed, "--speed")
     names = split_planners(planners)
@@ -261,6 +261,9 @@ def moving_cmd(
                    f"{' replan' if replan else ''}: success {r['success_rate']:.3f}, collision "
                    f"{r['collision_rate']:.3f}, replans {r['replans_mean']:.2f}/run, latency "
                    f"median {r['latency_median_s'] * 1e3:.3g} ms, max {r['latency_max_s'] * 1e3:.3g} ms")
+        why = diagnosis(r)
+        if why is not None:
+            typer.echo(f"  why: {why}")
     if out is not None:
         _write_csv(table, out / "moving_obstacles.csv")
         typer.echo(f"table written to {out}")

@@ -233,3 +233,16 @@ def test_robustness_moving_prints_the_diagnosis_line(run_cli):
     assert proc.returncode == 0, proc.stderr
     why = [line for line in proc.stdout.splitlines() if line.strip().startswith("why:")]
     assert len(why) == 1 and "runs failed" in why[0], proc.stdout
+
+
+# ------------------------------------------------------------------ 7. generated endpoints
+
+
+@pytest.mark.parametrize("k", [11, 20])  # the demo's problems that broke it (2.54 mm, 2.6 µm)
+def test_generated_problems_keep_five_millimetres_at_start_and_goal(k):
+    from xfuzzy_rrt.geometry.collision import clearance
+    from xfuzzy_rrt.scenarios.generate import generate_one
+
+    a = generate_one(2000, k).scenario.arrays()
+    assert clearance(a, a.start_deg) >= 0.005
+    assert clearance(a, a.goal_deg) >= 0.005

@@ -246,3 +246,134 @@ def test_generated_problems_keep_five_millimetres_at_start_and_goal(k):
     a = generate_one(2000, k).scenario.arrays()
     assert clearance(a, a.start_deg) >= 0.005
     assert clearance(a, a.goal_deg) >= 0.005
+
+
+# ------------------------------------------------------------------ 9. rules eval, README, figures
+
+
+def test_rules_eval_warns_once_per_clamped_column_and_still_clamps(run_cli, tmp_path):
+    inputs = tmp_path / "in.csv"
+    inputs.write_text("angle_to_goal,dist_to_goal,angle_to_obstacle,dist_to_obstacle\n"
+                      "45,0.1,-90,0.02\n0.5,0.1,5.5,0.02\n30,0.1,0.2,0.02\n")
+    proc = run_cli("rules", "eval", PROJECT / "rulebooks" / "expert", "--input", inputs,
+                   "--output", tmp_path / "out.csv")
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 2, proc.stderr
+    assert "angle_to_goal: 2 of 3 values outside" in lines[0] and "clamped" in lines[0]
+    assert "angle_to_obstacle: 1 of 3 values outside" in lines[1]
+    assert (tmp_path / "out.csv").exists()
+
+
+def _readme() -> str:
+    return (PROJECT / "README.md").read_text()
+
+
+def test_readme_rules_eval_example_feeds_inputs_in_their_units():
+    import io
+
+    import pandas as pd
+
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+    from xfuzzy_rrt.fuzzy.tables import clamped_inputs
+
+    line = next(x for x in _readme().splitlines() if x.startswith("printf 'angle_to_goal"))
+    csv = line.split("'")[1].replace("\\n", "\n")
+    df = pd.read_csv(io.StringIO(csv))
+    assert clamped_inputs(load_rulebook(PROJECT / "rulebooks" / "expert"), df) == []
+
+
+def test_readme_robustness_examples_name_files_that_exist_in_a_fresh_clone():
+    text = _readme()
+    assert "/tmp/x " not in text and "XXXX" not in text
+    commands = [x.split() for x in text.splitlines()
+                if x.strip().startswith("xfuzzy-rrt robustness ")]
+    assert commands
+    for words in commands:
+        target = words[3]
+        if target.startswith("reports/"):  # written by a bench command just before it
+            assert f"--out {target}" in text, target
+        else:
+            assert target.startswith("../shared/") or (PROJECT / target).exists(), target
+    assert "a fresh clone has none" in text
+    assert (PROJECT / "xfuzzy_rrt" / "data" / "reference" / "paper-reference.toml").exists()
+
+
+def _label_rows_of(fig):
+    """{subplot: [(x, y, text)]} of a membership figure's term labels."""
+    out: dict[str, list] = {}
+    for a in fig.to_dict()["layout"]["annotations"]:
+        out.setdefault(a["xref"], []).append((a["x"], a["y"], a["text"]))
+    return out
+
+
+@pytest.mark.parametrize("name", ["goal-frame", "general", "paper"])
+def test_membership_labels_that_would_overlap_are_on_different_rows(name):
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+    from xfuzzy_rrt.report import fuzzy_figures as ff
+
+    rb = load_rulebook(PROJECT / "rulebooks" / name)
+    for fis in rb.systems:
+        fig = ff.membership_figure(fis, [fis.output], rb)
+        labels = _label_rows_of(fig)
+        axis_px = ff.LABEL_AXIS_PX / len(fis.inputs)
+        for c, inp in enumerate(fis.inputs):
+            ref = f"x{c + 1}" if c else "x"
+            span = inp.peaks[-1] - inp.peaks[0]
+            items = labels[ref]
+            for i, (x1, y1, t1) in enumerate(items):
+                for x2, y2, t2 in items[i + 1:]:
+                    gap_px = abs(x1 - x2) / span * axis_px
+                    needed = 0.5 * (len(t1) + len(t2)) * ff.LABEL_CHAR_PX
+                    if gap_px < needed:
+                        assert y1 != y2, (name, fis.output, inp.name, t1, t2)
+
+
+def test_crowded_goal_frame_clearance_labels_are_not_on_one_row():
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+    from xfuzzy_rrt.report import fuzzy_figures as ff
+
+    rb = load_rulebook(PROJECT / "rulebooks" / "goal-frame")
+    fis = rb.systems[0]
+    c = [inp.name for inp in fis.inputs].index("clearance_deg")
+    items = _label_rows_of(ff.membership_figure(fis, [fis.output], rb))[f"x{c + 1}" if c else "x"]
+    ys = [y for _, y, _ in sorted(items)]
+    assert ys[0] != ys[1] and ys[0] != ys[2] and ys[1] != ys[2]  # peaks 0, 2.4, 5.6 of 30
+
+
+def test_training_compiles_before_generation_one_is_timed(tmp_path, monkeypatch):
+    """Generation 1 reported "0 runs/s": its clock included numba's first compile. The
+    engines are now warmed up (kernels compiled, workers started) before any timed call."""
+    from xfuzzy_rrt.cli.main import main
+    from xfuzzy_rrt.training import workers
+
+    events: list[str] = []
+    real = workers.make_evaluator
+
+    class Recording:
+        def __init__(self, engine):
+            self.engine = engine
+            self.description = engine.description
+
+        def __enter__(self):
+            self.engine.__enter__()
+            return self
+
+        def __exit__(self, *exc):
+            return self.engine.__exit__(*exc)
+
+        def warm_up(self, genes):
+            events.append("warm")
+            self.engine.warm_up(genes)
+
+        def __call__(self, genes, seeds, progress=None):
+            events.append("evaluate")
+            return self.engine(genes, seeds, progress)
+
+    monkeypatch.setattr(workers, "make_evaluator", lambda *a, **k: Recording(real(*a, **k)))
+    monkeypatch.chdir(tmp_path)
+    code = main(["train", "--scenario", str(SCENARIO), "--population", "4", "--generations",
+                 "1", "--runs-per-eval", "1", "--elite", "1", "--bounds", "relative", "--workers", "1",
+                 "--validation-runs", "1", "--out", "rb"])
+    assert code == 0
+    assert events and events[0] == "warm", events

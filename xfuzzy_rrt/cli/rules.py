@@ -47,6 +47,12 @@ def eval_(
     rb = load_rulebook(rulebook)
     df = read_inputs_csv(input, rb.inputs)
     result = evaluate_frame(rb, df)
+    from xfuzzy_rrt.cli.common import warn
+    from xfuzzy_rrt.fuzzy.tables import clamped_inputs
+
+    for name, n, lo, hi in clamped_inputs(rb, df):
+        warn(f"{input}: {name}: {n} of {len(df)} values outside [{lo:g}, {hi:g}] were clamped "
+             "to the range")
     with atomic_path(output) as tmp:
         result.to_csv(tmp, index=False, float_format="%.17g")
     _out(_eval_echo(result, rb, output))

@@ -96,6 +96,13 @@ def pytest_configure(config):
     workers = getattr(config.option, "numprocesses", None)
     if not is_worker and workers not in (None, 0, "0"):
         _warm_numba_cache()
+    if is_worker:
+        # xdist workers start with SIGINT ignored, and an ignored signal stays ignored in every
+        # process they start: the interruption tests' Ctrl-C would never reach the CLI. Give
+        # the worker Python's own handler back, so its children start with the default.
+        import signal
+
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 # ------------------------------------------------------------------ OMPL teardown noise

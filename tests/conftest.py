@@ -71,6 +71,40 @@ def thin_box(tmp_path: Path, ylo: float = -0.002, yhi: float = 0.002) -> Path:
     return path
 
 
+# ------------------------------------------------------------------ parallel runs (xdist)
+#
+# Why: with ``-n auto`` every worker would compile the same numba kernels side by side on a
+# cold cache (minutes each, and two writers of one cache entry). The controller compiles the
+# core planning kernels once, before any worker starts; the workers then load numba's on-disk
+# cache. Tests write only under ``tmp_path`` (per test, so per worker), never to fixed paths.
+
+
+def _warm_numba_cache() -> None:
+    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.planners.api import plan_scenario
+
+    s = load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml")
+    plan_scenario(s, planner="rrt", seed=0, max_iter=20)
+    for name in ("goal-frame", "expert"):
+        plan_scenario(s, planner="fuzzy-rrt", rulebook=rulebooks_dir() / name, seed=0,
+                      max_iter=20, trace=True)
+
+
+def pytest_configure(config):
+    is_worker = getattr(config, "workerinput", None) is not None
+    workers = getattr(config.option, "numprocesses", None)
+    if not is_worker and workers not in (None, 0, "0"):
+        _warm_numba_cache()
+    if is_worker:
+        # xdist workers start with SIGINT ignored, and an ignored signal stays ignored in every
+        # process they start: the interruption tests' Ctrl-C would never reach the CLI. Give
+        # the worker Python's own handler back, so its children start with the default.
+        import signal
+
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 # ------------------------------------------------------------------ OMPL teardown noise
 #
 # Why: the ompl 2.0.1 wheel never frees the C++ graph of a BIT* planner once

@@ -27,6 +27,37 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.manifest import thaw
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED, N_RULES, rule_terms
 
+class _Absent:
+    """A key one rulebook has and the other lacks (shown as ``absent``, never ``nan``)."""
+
+    def __repr__(self) -> str:
+        return "absent"
+
+    __str__ = __repr__
+
+    def __reduce__(self):  # one instance, also across processes
+        return "ABSENT"
+
+
+ABSENT = _Absent()
+#: Numbers closer than this (relative) differ only by float rounding (an FLL round trip, a
+#: decimal print): not a documentary difference, and summarised in one line among cells.
+ROUNDING_REL = 1e-12
+
+
+def rounding_only(a: Any, b: Any, rel: float = ROUNDING_REL) -> bool:
+    """``a`` and ``b`` are (nested lists of) numbers equal to within ``rel`` relative."""
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(rounding_only(x, y, rel) for x, y in zip(a, b))
+    if isinstance(a, bool) or isinstance(b, bool):
+        return a == b
+    if isinstance(a, (int, float, np.integer, np.floating)) and isinstance(
+            b, (int, float, np.integer, np.floating)):
+        a, b = float(a), float(b)
+        return a == b or abs(a - b) <= rel * max(abs(a), abs(b))
+    return a == b
+
+
 CELL_COLUMNS = ["output", "rule", "antecedent", "a", "b", "delta"]
 PEAK_COLUMNS = ["output", "input", "term", "a", "b", "shift"]
 META_COLUMNS = ["field", "a", "b"]
@@ -54,6 +85,13 @@ class RulebookDiff:
         """Same behaviour: equal constants, peaks and bounds mode (documentation aside)."""
         return self.cells.empty and self.peaks.empty and self.bounds_mode is None
 
+    @staticmethod
+    def rounding_mask(cells: pd.DataFrame) -> pd.Series:
+        """Rows of ``cells`` whose change is float rounding only (:data:`ROUNDING_REL`)."""
+        a = cells["a"].astype(float).abs()
+        b = cells["b"].astype(float).abs()
+        return cells["delta"].astype(float).abs() <= ROUNDING_REL * np.maximum(a, b)
+
     def per_output(self) -> pd.DataFrame:
         """Changed cells per FIS with the largest absolute change."""
         rows = []
@@ -61,7 +99,8 @@ class RulebookDiff:
             g = self.cells[self.cells["output"] == out]
             rows.append({"output": out, "cells_changed": len(g),
                          "max_abs_delta": float(g["delta"].abs().max()) if len(g) else 0.0,
-                         "peaks_moved": int((self.peaks["output"] == out).sum())})
+                         "peaks_moved": int((self.peaks["output"] == out).sum()),
+                         "cells_rounding_only": int(self.rounding_mask(g).sum())})
         return pd.DataFrame(rows)
 
 
@@ -109,8 +148,9 @@ def diff_rulebooks(a, b) -> RulebookDiff:
     _flat("provenance.", thaw(a.provenance), pa)
     _flat("provenance.", thaw(b.provenance), pb)
     for key in sorted(set(pa) | set(pb)):
-        if pa.get(key) != pb.get(key):
-            doc.append((key, pa.get(key), pb.get(key)))
+        va, vb = pa.get(key, ABSENT), pb.get(key, ABSENT)
+        if va is ABSENT or vb is ABSENT or not rounding_only(va, vb):
+            doc.append((key, va, vb))
     return RulebookDiff(
         a_name=a.name, b_name=b.name, a_sha256=a.sha256, b_sha256=b.sha256,
         cells=pd.DataFrame(cells, columns=CELL_COLUMNS),

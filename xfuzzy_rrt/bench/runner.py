@@ -170,6 +170,19 @@ def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
     return r, row
 
 
+def check_pairs(scenarios: list[Scenario], rulebooks: dict[str, Any]) -> None:
+    """Every (scenario, Fuzzy-RRT rulebook) pair fits -- the rulebook's DOF drives the arms --
+    checked before the first run, so a 5-DOF problem among 2-DOF ones fails at once rather
+    than after the runs before it (one line naming the scenario file and the rulebook)."""
+    from xfuzzy_rrt.planners.checks import check_dof
+    from xfuzzy_rrt.planners.fuzzy_rrt import check_rulebook_fits
+
+    for s in scenarios:
+        check_dof(s)
+        for rb in rulebooks.values():
+            check_rulebook_fits(rb, s)
+
+
 def _warm_up(scenario: Scenario, planners: list[str], rulebooks: dict[str, Any]) -> None:
     """Compile/load the kernels once so that no timed run pays JIT cost.
 
@@ -236,6 +249,9 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
         raise InputError("--runs", f"must be >= 1, got {runs}")
     if workers < 1:
         raise InputError("--workers", f"must be >= 1, got {workers}")
+    from xfuzzy_rrt.planners.rng import check_seed
+
+    check_seed(seed, runs)
     if not scenarios:
         raise InputError("scenarios", "no scenario to run")
     names = [s.name for s in scenarios]
@@ -243,6 +259,7 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
         dup = sorted({n for n in names if names.count(n) > 1})[0]
         raise InputError("scenarios", f"two scenario files share the name {dup!r}")
     rulebooks, rulebook_dirs = load_rulebooks(planners, rulebook)
+    check_pairs(scenarios, rulebooks)
     jobs = [_Job(s, p, rulebooks.get(p), seed + k, max_iter, shortcut)
             for s in scenarios for p in planners for k in range(runs)]
     _warm_up(scenarios[0], planners, rulebooks)

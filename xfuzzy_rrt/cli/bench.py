@@ -10,6 +10,8 @@ from typing import List, Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option, split_planners
+
 
 class ProgressBar:
     """Runs done / total on stderr: a redrawn bar on a terminal, a few plain lines otherwise
@@ -75,7 +77,12 @@ def _run(scenarios: List[Path], planners: str, runs: int, seed: int, rulebook: O
     from xfuzzy_rrt.bench.store import check_out_dir, staged_folder
     from xfuzzy_rrt.cli.common import load_scenario_warn, test_signal
 
-    names = check_planners([p.strip() for p in planners.split(",") if p.strip()])
+    names = check_planners(split_planners(planners))
+    if rulebook is not None and "fuzzy-rrt" not in names:
+        from xfuzzy_rrt.errors import InputError
+
+        raise InputError("--rulebook", "is the rulebook of plain fuzzy-rrt, which --planners does "
+                         "not list (add fuzzy-rrt, or name it as fuzzy-rrt:DIR)")
     files = scenario_files(scenarios)
     check_out_dir(out, files, keep)  # fail before planning, not after
     from xfuzzy_rrt.geometry.clearance import with_clearance
@@ -119,12 +126,12 @@ def bench(
              "fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR (a rulebook directory; "
              "several side by side), ompl:NAME (e.g. ompl:RRTConnect)."),
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),
-    seed: int = typer.Option(0, "--seed", help="First seed; run k uses seed + k."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="First seed; run k uses seed + k."),
     rulebook: Optional[Path] = typer.Option(None, "--rulebook",
                                             help="Rulebook directory of plain fuzzy-rrt."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Output folder (default reports/bench-<time>)."),
-    workers: int = typer.Option(1, "--workers", min=1, help="Worker processes."),
+    workers: int = typer.Option(1, "--workers", callback=check_workers_option, min=1, help="Worker processes."),
     shortcut: bool = typer.Option(False, "--shortcut",
                                   help="Also shorten every path by certified shortcutting "
                                        "(cost_short_deg; cost_deg stays the raw cost)."),
@@ -139,7 +146,7 @@ def bench(
 def demo(
     out: Path = typer.Option(Path("reports/demo"), "--out", help="Output folder."),
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),
-    workers: int = typer.Option(2, "--workers", min=1, help="Worker processes."),
+    workers: int = typer.Option(2, "--workers", callback=check_workers_option, min=1, help="Worker processes."),
     problems: int = typer.Option(24, "--problems", min=1, max=1000,
                                  help="Generated problems to benchmark (generator seed 2000)."),
 ) -> int:

@@ -18,6 +18,49 @@ def warn(message: str) -> None:
     sys.stderr.write(f"warning: {message}\n")
 
 
+def check_seed_option(value: int) -> int:
+    """Typer callback of every ``--seed`` option: one line naming ``--seed`` and the valid
+    range (:func:`xfuzzy_rrt.planners.rng.check_seed`) instead of a numba traceback."""
+    from xfuzzy_rrt.planners.rng import check_seed
+
+    return check_seed(value)
+
+
+#: Most worker processes any command starts. Why a cap: ``--workers 100000`` used to be taken
+#: at its word and recorded in bench.json; more workers than this (or than 8 per core) only
+#: adds start-up time and memory on any machine this runs on.
+MAX_WORKERS = 256
+
+
+def check_workers(value: int | None, option: str = "--workers") -> int | None:
+    """``None`` (the command's default) or 1 .. min(256, 8 x cores); else one InputError."""
+    if value is None:
+        return None
+    cores = os.cpu_count() or 1
+    cap = min(MAX_WORKERS, 8 * cores)
+    if value < 1:
+        raise InputError(option, f"must be >= 1, got {value}")
+    if value > cap:
+        why = (f"the maximum is {MAX_WORKERS}" if cap == MAX_WORKERS
+               else f"at most 8 per core ({cores} cores here)")
+        raise InputError(option, f"{value} workers is too many: {why}, so at most {cap}")
+    return value
+
+
+def check_workers_option(value: int | None) -> int | None:
+    """Typer callback of every ``--workers`` option (:func:`check_workers`)."""
+    return check_workers(value)
+
+
+def split_planners(text: str, option: str = "--planners") -> list[str]:
+    """A comma list of planner labels; an empty entry (``rrt,,fuzzy-rrt``, a trailing comma)
+    is refused rather than skipped, since it is usually a typo for a missing name."""
+    names = [p.strip() for p in text.split(",")]
+    if any(not n for n in names):
+        raise InputError(option, f"empty planner name in {text!r} (remove the extra comma)")
+    return names
+
+
 def load_scenario_warn(path: Path):
     """Load a scenario (an unknown key is an error there, not a warning: see xfuzzy_rrt.strict)."""
     from xfuzzy_rrt.geometry.scenario import load_scenario

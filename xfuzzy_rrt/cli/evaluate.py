@@ -8,6 +8,8 @@ from typing import List, Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import check_seed_option
+
 
 def _rulebook(spec: str):
     """A shipped rulebook's name, or a rulebook directory."""
@@ -34,7 +36,7 @@ def evaluate(
     peer: List[str] = typer.Option([], "--peer", help="Also run this planner, e.g. ompl:RRTConnect (repeatable; ranked on time)."),
     tuned: bool = typer.Option(True, "--tuned/--no-tuned", help="Run the tuned RRT (rrt:tuned) beside the paper's RRT and rank time and work against it (default: yes)."),
     runs: int = typer.Option(50, "--runs", help="Seeds per problem (seed .. seed + runs - 1, the same for every planner)."),
-    seed: int = typer.Option(0, "--seed", help="First seed."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="First seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run; a failure counts as this many iterations."),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for runs.csv, problems.csv and summary.csv."),
     clearance: Optional[float] = typer.Option(None, "--clearance", help="Certified clearance in metres every planner must keep (default: each scenario's [safety] clearance_m, else 0)."),

@@ -8,6 +8,8 @@ from typing import Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import check_seed_option
+
 
 class PlannerName(str, enum.Enum):
     rrt = "rrt"
@@ -22,7 +24,7 @@ def plan(
              "ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
     rulebook: Optional[Path] = typer.Option(
         None, "--rulebook", help="Rulebook directory (fuzzy-rrt; default: the shipped default)."),
-    seed: int = typer.Option(0, "--seed", help="Random seed."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Random seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON here (default: stdout)."),
     trace: Optional[Path] = typer.Option(
@@ -44,6 +46,11 @@ def plan(
     from xfuzzy_rrt.planners.termination import check_max_time
 
     spec = parse_planner(planner, "--planner")
+    if rulebook is not None and spec.kind != "fuzzy-rrt":
+        from xfuzzy_rrt.errors import InputError
+
+        raise InputError("--rulebook", f"only fuzzy-rrt plans with a rulebook; --planner "
+                         f"{planner} would ignore it (drop --rulebook or use --planner fuzzy-rrt)")
     if trace is not None:
         write_trace_checked(trace)  # reject a bad suffix before any work is done
     check_output_file(out, "--out")
@@ -68,7 +75,7 @@ def plan(
     if trace is not None:
         from xfuzzy_rrt.planners.api import write_trace
 
-        write_trace(result, trace)
+        write_trace(result, trace, rulebook_dir=rulebook_dir)
     data = result.to_json_dict()
     # Where the inputs came from, so that 'xfuzzy-rrt explain RESULT.json' can replay the run.
     data["scenario_file"] = str(scenario.resolve())
@@ -79,7 +86,25 @@ def plan(
 
         sys.stderr.write(f"not certified: {scenario}: {result.planner} seed {seed}: "
                          f"{result.violation}\n")
+    if not result.found:
+        import sys
+
+        sys.stderr.write(no_path_line(scenario, result, max_iter, max_time, out) + "\n")
     return 0 if result.success else 1
+
+
+def no_path_line(scenario: Path, result, max_iter: int, max_time: float | None,
+                 out: Path | None) -> str:
+    """Why exit 1 without a path, in one line: the budget that ran out and where the (still
+    valid, SPEC.md) JSON result went, so a silent exit 1 is never the whole answer."""
+    stopped = (result.params or {}).get("stopped_by")
+    if stopped == "time" and max_time is not None:
+        budget = f"within --max-time {max_time:g} s ({result.iterations} iterations)"
+    else:
+        budget = f"within {max_iter} iterations (--max-iter)"
+    where = f"the result was written to {out}" if out is not None else "the result is on stdout"
+    return (f"no path: {scenario}: {result.planner} seed {result.seed} found no path {budget}; "
+            f"{where}")
 
 
 def register(app: typer.Typer) -> None:

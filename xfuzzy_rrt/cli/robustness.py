@@ -11,6 +11,8 @@ from typing import Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option, split_planners
+
 app = typer.Typer(
     help="Stochastic Robustness Analysis: how often a planned path (or a planner's paths) "
          "touches an obstacle when the obstacles are not where the model says (--sigma, "
@@ -107,8 +109,8 @@ def path_cmd(
     sigma_joint_deg: float = typer.Option(0.0, "--sigma-joint-deg", help="Joint tracking error σ per waypoint (degrees)."),
     distribution: str = typer.Option("normal", "--distribution", help="normal, or uniform (bounded, ±√3σ: same σ)."),
     trials: int = typer.Option(10_000, "--trials", help="Monte Carlo trials per σ."),
-    seed: int = typer.Option(0, "--seed", min=0, help="Noise seed: same seed, same numbers, any --workers."),
-    workers: Optional[int] = typer.Option(None, "--workers", help="Threads (default: all cores)."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, min=0, help="Noise seed: same seed, same numbers, any --workers."),
+    workers: Optional[int] = typer.Option(None, "--workers", callback=check_workers_option, help="Threads (default: all cores)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for path_robustness.csv and trials.csv."),
     html: bool = typer.Option(False, "--html", help="Also write robustness.html (needs --out)."),
 ) -> int:
@@ -137,8 +139,8 @@ def bench_cmd(
     sigma_joint_deg: float = typer.Option(0.0, "--sigma-joint-deg", help="Joint tracking error σ per waypoint (degrees)."),
     distribution: str = typer.Option("normal", "--distribution", help="normal, or uniform (bounded, ±√3σ: same σ)."),
     trials: int = typer.Option(10_000, "--trials", help="Monte Carlo trials per σ and path."),
-    seed: int = typer.Option(0, "--seed", min=0, help="Noise seed."),
-    workers: Optional[int] = typer.Option(None, "--workers", help="Threads (default: all cores)."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, min=0, help="Noise seed."),
+    workers: Optional[int] = typer.Option(None, "--workers", callback=check_workers_option, help="Threads (default: all cores)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for the tables (default: FOLDER/robustness)."),
     html: bool = typer.Option(False, "--html", help="Also write robustness.html."),
 ) -> int:
@@ -166,13 +168,13 @@ def planners_cmd(
     distribution: str = typer.Option("normal", "--distribution", help="normal or uniform."),
     runs: int = typer.Option(10, "--runs", min=1, max=10_000, help="Plans per (scenario, planner, σ)."),
     trials: int = typer.Option(2000, "--trials", help="Monte Carlo trials per planned path."),
-    seed: int = typer.Option(0, "--seed", min=0, help="First seed (run k uses seed + k)."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, min=0, help="First seed (run k uses seed + k)."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget."),
     clearance: Optional[float] = typer.Option(None, "--clearance", help="Planning clearance (m; default: the scenario's)."),
     margins: Optional[str] = typer.Option(None, "--margins", help="Comma list of clearances (m): find the smallest with P(collision) <= --target at --margin-sigma."),
     margin_sigma: float = typer.Option(0.002, "--margin-sigma", help="σ (m) for --margins."),
     target: float = typer.Option(0.01, "--target", help="Collision probability the margin must keep (upper 95 % bound)."),
-    workers: Optional[int] = typer.Option(None, "--workers", help="Threads (default: all cores)."),
+    workers: Optional[int] = typer.Option(None, "--workers", callback=check_workers_option, help="Threads (default: all cores)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for planner_robustness.csv (and margin_needed.csv)."),
 ) -> int:
     """Plan on a perturbed model and execute on the true one (and the reverse), per planner and σ."""
@@ -182,7 +184,7 @@ def planners_cmd(
     from xfuzzy_rrt.robustness.sweep import margin_needed, planner_sweep
 
     sigmas = _floats(sigma, "--sigma")
-    names = [p.strip() for p in planners.split(",") if p.strip()]
+    names = split_planners(planners)
     if not names:
         raise InputError("--planners", "needs at least one planner")
     for name in names:
@@ -229,7 +231,7 @@ def moving_cmd(
     rate: float = typer.Option(20.0, "--rate", help="Executor rate (Hz): re-check and collision record per tick."),
     replan: bool = typer.Option(False, "--replan", help="Re-check the remaining path every tick and replan from the current configuration when it is invalidated."),
     runs: int = typer.Option(10, "--runs", min=1, max=10_000, help="Executions per (scenario, planner, speed)."),
-    seed: int = typer.Option(0, "--seed", min=0, help="First seed (run k uses seed + k)."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, min=0, help="First seed (run k uses seed + k)."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per plan."),
     clearance: Optional[float] = typer.Option(None, "--clearance", help="Planning clearance (m; default: the scenario's)."),
     time_limit: float = typer.Option(30.0, "--time-limit", help="Give up after this many simulated seconds."),
@@ -239,10 +241,10 @@ def moving_cmd(
     from xfuzzy_rrt.cli.common import load_scenario_warn
     from xfuzzy_rrt.errors import InputError
     from xfuzzy_rrt.planners.api import check_planner
-    from xfuzzy_rrt.robustness.moving import moving_obstacles
+    from xfuzzy_rrt.robustness.moving import diagnosis, moving_obstacles
 
     speeds = _floats(speed, "--speed")
-    names = [p.strip() for p in planners.split(",") if p.strip()]
+    names = split_planners(planners)
     if not names:
         raise InputError("--planners", "needs at least one planner")
     for name in names:
@@ -259,6 +261,9 @@ def moving_cmd(
                    f"{' replan' if replan else ''}: success {r['success_rate']:.3f}, collision "
                    f"{r['collision_rate']:.3f}, replans {r['replans_mean']:.2f}/run, latency "
                    f"median {r['latency_median_s'] * 1e3:.3g} ms, max {r['latency_max_s'] * 1e3:.3g} ms")
+        why = diagnosis(r)
+        if why is not None:
+            typer.echo(f"  why: {why}")
     if out is not None:
         _write_csv(table, out / "moving_obstacles.csv")
         typer.echo(f"table written to {out}")

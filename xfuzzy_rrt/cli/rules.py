@@ -15,6 +15,8 @@ from typing import List, Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option
+
 app = typer.Typer(help="Inspect, validate, evaluate and convert rulebooks.", no_args_is_help=True)
 
 
@@ -45,6 +47,12 @@ def eval_(
     rb = load_rulebook(rulebook)
     df = read_inputs_csv(input, rb.inputs)
     result = evaluate_frame(rb, df)
+    from xfuzzy_rrt.cli.common import warn
+    from xfuzzy_rrt.fuzzy.tables import clamped_inputs
+
+    for name, n, lo, hi in clamped_inputs(rb, df):
+        warn(f"{input}: {name}: {n} of {len(df)} values outside [{lo:g}, {hi:g}] were clamped "
+             "to the range")
     with atomic_path(output) as tmp:
         result.to_csv(tmp, index=False, float_format="%.17g")
     _out(_eval_echo(result, rb, output))
@@ -277,9 +285,9 @@ def coverage(
     sources: List[Path] = typer.Argument(..., help="Scenario TOML files or directories (planned "
                                          "--runs times each), or saved trace files (.parquet/.csv)."),
     runs: int = typer.Option(10, "--runs", min=1, help="Runs per scenario (seeds seed..seed+runs-1)."),
-    seed: int = typer.Option(0, "--seed", help="First seed."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="First seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run."),
-    workers: int = typer.Option(1, "--workers", min=1, help="Worker processes."),
+    workers: int = typer.Option(1, "--workers", callback=check_workers_option, min=1, help="Worker processes."),
     out: Optional[Path] = typer.Option(None, "--out", help="CSV: one row per FIS and rule (3,750 rows at 2 DOF)."),
     html: Optional[Path] = typer.Option(None, "--html", help="HTML page with 25x25 heatmaps per FIS."),
     top: int = typer.Option(5, "--top", min=0, help="Rules to list per FIS (largest output mass)."),
@@ -335,6 +343,44 @@ def coverage(
 # ---------------------------------------------------------------------- analysis: diff
 
 
+def _short(value, width: int = 72) -> str:
+    """A value in at most ``width`` characters (long lists and texts say how long they are)."""
+    text = repr(value)
+    if len(text) <= width:
+        return text
+    size = f"{len(value)} items" if isinstance(value, (list, tuple)) else f"{len(text)} chars"
+    return f"{text[:width - 20]}... ({size})"
+
+
+def _documentary_lines(doc, limit: int) -> list[str]:
+    """Documentary differences, compact: changed values shortened, keys that only one side has
+    listed by name on one line per side (an FLL round trip drops the whole provenance)."""
+    from xfuzzy_rrt.analysis.diff import ABSENT
+
+    lines = []
+    only = {"a": [], "b": []}
+    changed = []
+    for f in doc.itertuples(index=False):
+        if f.b is ABSENT:
+            only["a"].append(f.field)
+        elif f.a is ABSENT:
+            only["b"].append(f.field)
+        else:
+            changed.append(f)
+    for f in changed[:limit]:
+        lines.append(f"note: {f.field}: {_short(f.a)} -> {_short(f.b)}")
+    if len(changed) > limit:
+        lines.append(f"note: ... and {len(changed) - limit} more documentary differences "
+                     "(--limit, --html)")
+    for side, other in (("a", "b"), ("b", "a")):
+        keys = only[side]
+        if keys:
+            shown = ", ".join(keys[:limit]) + (f", ... ({len(keys) - limit} more)"
+                                               if len(keys) > limit else "")
+            lines.append(f"note: {len(keys)} key(s) only in {side} (absent in {other}): {shown}")
+    return lines
+
+
 @app.command("diff")
 def diff(
     a: Path = typer.Argument(..., help="Rulebook directory A."),
@@ -343,7 +389,7 @@ def diff(
     out: Optional[Path] = typer.Option(None, "--out", help="CSV of every changed cell."),
     limit: int = typer.Option(50, "--limit", min=0, help="Changed cells to print per FIS."),
     replay: Optional[Path] = typer.Option(None, "--replay", help="Scenario to plan with both rulebooks."),
-    seed: int = typer.Option(0, "--seed", help="Seed for --replay."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Seed for --replay."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget for --replay."),
 ) -> int:
     """Exit 0 when A and B behave identically, 1 when they differ (differences on stdout)."""
@@ -364,6 +410,10 @@ def diff(
             lines.append(f"{row.output}: {row.cells_changed} cells changed "
                          f"(max |b - a| {row.max_abs_delta:.6g}), {row.peaks_moved} peaks moved")
             g = d.cells[d.cells["output"] == row.output]
+            if row.cells_rounding_only:
+                lines.append(f"  {row.cells_rounding_only} of them differ only by float rounding "
+                             "(<= 1e-12 relative; listed with --out)")
+                g = g[~d.rounding_mask(g)]
             for c in g.head(limit).itertuples(index=False):
                 lines.append(f"  r{c.rule}: {c.a!r} -> {c.b!r} ({c.delta:+.6g})  if {c.antecedent}")
             if len(g) > limit:
@@ -372,10 +422,7 @@ def diff(
                 lines.append(f"  peak {p.input}.{p.term}: {p.a!r} -> {p.b!r} ({p.shift:+.6g})")
     if d.bounds_mode:
         lines.append(f"bounds mode: {d.bounds_mode[0]} -> {d.bounds_mode[1]}")
-    for f in d.documentary.head(limit).itertuples(index=False):
-        lines.append(f"note: {f.field}: {f.a!r} -> {f.b!r}")
-    if len(d.documentary) > limit:
-        lines.append(f"note: ... and {len(d.documentary) - limit} more documentary differences (--limit, --html)")
+    lines.extend(_documentary_lines(d.documentary, limit))
     rep = None
     if scenario is not None:
         rep = replay_diff(scenario, ra, rb, seed=seed, max_iter=max_iter)
@@ -383,9 +430,12 @@ def diff(
         if rep.divergence is None:
             lines.append(f"  no divergence: identical decisions in all {rep.result_a.iterations} iterations")
         else:
+            plan_note = (f"the plan itself (sample, outcome) first differs at iteration "
+                         f"{rep.plan_divergence}" if rep.plan_divergence is not None else
+                         "the plans are identical (same samples, outcomes and nodes in all "
+                         f"{rep.result_a.iterations} iterations)")
             lines.append(f"  first divergence at iteration {rep.divergence} (decisions before it "
-                         "identical); the plan itself (sample, outcome) first differs at "
-                         f"iteration {rep.plan_divergence}")
+                         f"identical); {plan_note}")
             for q in rep.decisions.itertuples(index=False):
                 lines.append(f"    {q.quantity}: {q.a} | {q.b}")
             for c in rep.causes.itertuples(index=False):
@@ -445,7 +495,7 @@ def simplify_cmd(
                                          "(mean iterations over --scenario x --seeds)."),
     scenario: Optional[List[Path]] = typer.Option(None, "--scenario", help="Scenario for the budget check (repeatable)."),
     seeds: int = typer.Option(10, "--seeds", min=1, help="Seeds per scenario for the budget check."),
-    seed: int = typer.Option(0, "--seed", help="First seed of the budget check."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="First seed of the budget check."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run."),
     levels: Optional[int] = typer.Option(None, "--levels", help="Round constants to K levels per FIS (lossy)."),
     tolerance: Optional[float] = typer.Option(None, "--tolerance", help="Merge rules whose constants differ "
@@ -454,7 +504,7 @@ def simplify_cmd(
                                          "their neighbours' values (lossy)."),
     strict: bool = typer.Option(False, "--strict", help="Require loss + 1.645 standard errors "
                                 "(paired over seeds) to be within the budget, not just the mean."),
-    workers: int = typer.Option(1, "--workers", min=1, help="Worker processes for the budget runs."),
+    workers: int = typer.Option(1, "--workers", callback=check_workers_option, min=1, help="Worker processes for the budget runs."),
     holdout_seeds: Optional[int] = typer.Option(None, "--holdout-seeds", min=1, help="Fresh seeds per scenario (never searched on) to re-measure a lossy result's loss (default: --seeds)."),
 ) -> int:
     """Fewest 'any' rules with the same constants; lossy steps only within a stated budget."""

@@ -8,6 +8,8 @@ from typing import Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import check_seed_option
+
 app = typer.Typer(help="Scenario files: generate problems of the sample-* family, N-DOF arms or several arms.",
                   no_args_is_help=True, add_completion=False, rich_markup_mode=None)
 
@@ -15,7 +17,7 @@ app = typer.Typer(help="Scenario files: generate problems of the sample-* family
 @app.command("generate")
 def generate(
     count: int = typer.Option(..., "--count", min=1, max=10_000, help="How many problems."),
-    seed: int = typer.Option(0, "--seed", min=0, help="Generator seed: same seed, same files."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, min=0, help="Generator seed: same seed, same files."),
     out: Path = typer.Option(..., "--out", help="Folder to write <name>.toml files into."),
     prefix: Optional[str] = typer.Option(None, "--prefix", help="Name prefix: <prefix>-<seed>-<k> (default: gen for the sample family, else the family's name)."),
     family: Optional[str] = typer.Option(None, "--family", help="2-DOF single-arm families: sample (the shared sample-* family; the default), hard (cluttered, thin walls, narrow passages) or mira (MIRA-like arm threading a gap between organs)."),

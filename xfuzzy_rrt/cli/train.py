@@ -9,6 +9,8 @@ from typing import List, Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option
+
 
 class _Progress:
     """One line per generation; on a terminal also a live bar while a generation runs."""
@@ -64,8 +66,8 @@ def train(
     generations: int = typer.Option(50, "--generations", help="Maximum generations (paper: 50)."),
     runs_per_eval: int = typer.Option(5, "--runs-per-eval", help="Planner runs per scenario per individual (paper: 5)."),
     target_fitness: Optional[float] = typer.Option(None, "--target-fitness", help="Stop when the best fitness reaches this (default: the paper's 9750 with --fitness paper; never with log-ratio)."),
-    seed: int = typer.Option(0, "--seed", help="Seed: the result depends only on it and the inputs."),
-    workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: all cores; 1 = in-process)."),
+    seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Seed: the result depends only on it and the inputs."),
+    workers: Optional[int] = typer.Option(None, "--workers", callback=check_workers_option, help="Local worker processes (default: all cores; 1 = in-process)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address (tcp://HOST:PORT): evaluate there."),
     out: Path = typer.Option(..., "--out", help="Rulebook directory to write (also history.csv and checkpoint/)."),
     resume: bool = typer.Option(False, "--resume", help="Continue from OUT/checkpoint after an interruption."),

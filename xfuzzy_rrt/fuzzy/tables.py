@@ -68,3 +68,21 @@ def evaluate_frame(rulebook, df):
     for j, name in enumerate(rulebook.outputs):
         out[name] = Y[:, j]
     return out
+
+
+def clamped_inputs(rulebook, df) -> list[tuple[str, int, float, float]]:
+    """Per input column with values outside its range: ``(name, how many, lo, hi)``.
+
+    The engine clamps such inputs to the range (they sit on a shoulder term; SPEC.md), which is
+    the intended behaviour, but silent clamping hides a unit mistake -- degrees fed to an input
+    in radians -- so ``rules eval`` reports these counts on stderr.
+    """
+    out = []
+    ranges = rulebook.semantics.input_ranges
+    for name in rulebook.inputs:
+        lo, hi = ranges[name]
+        x = df[name].to_numpy(dtype=np.float64)
+        n = int(np.count_nonzero((x < lo) | (x > hi)))
+        if n:
+            out.append((name, n, float(lo), float(hi)))
+    return out

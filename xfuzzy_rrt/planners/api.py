@@ -118,6 +118,9 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     ``max_time_s``: a wall-clock budget on top of ``max_iter`` (whichever ends first;
     :mod:`xfuzzy_rrt.planners.termination`).
     """
+    from xfuzzy_rrt.planners.rng import check_seed
+
+    check_seed(seed)
     spec = parse_planner(planner, "--planner")
     if spec.kind != "fuzzy-rrt" and trace:
         raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt")
@@ -177,13 +180,22 @@ def write_trace_checked(path: Path) -> None:
         raise InputError(str(path), "trace file must end in .parquet or .csv")
 
 
-def write_trace(result: PlanResult, path: Path) -> None:
-    """Write ``result.trace`` (a DataFrame) atomically as Parquet or CSV by suffix."""
+def write_trace(result: PlanResult, path: Path, rulebook_dir: str | Path | None = None) -> None:
+    """Write ``result.trace`` (a DataFrame) atomically as Parquet or CSV by suffix.
+
+    ``rulebook_dir``: the directory the rulebook was read from, recorded as the trace's
+    ``rulebook_dir`` column so that ``explain`` finds an edited copy of a shipped rulebook
+    (whose name is the original's) without being told.
+    """
     from xfuzzy_rrt.atomic import atomic_path
 
     write_trace_checked(path)
     if result.trace is None:
         raise InputError(str(path), "this result has no trace")
+    if rulebook_dir is not None:
+        from xfuzzy_rrt.planners.trace import with_rulebook_dir
+
+        result = dataclasses.replace(result, trace=with_rulebook_dir(result.trace, rulebook_dir))
     with atomic_path(path) as tmp:
         if Path(path).suffix.lower() == ".parquet":
             result.trace.to_parquet(tmp, index=False)

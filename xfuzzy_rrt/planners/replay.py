@@ -24,14 +24,65 @@ def trace_for(source: Path, rulebook: Path | None = None):
         return _replay_result(source, rulebook)
     frame = load_trace(source)
     if rulebook is None:
-        # The trace names its rulebook; look for a shipped one of that name.
-        name = str(frame["rulebook"].iloc[0]) if "rulebook" in frame and len(frame) else ""
-        candidate = rulebooks_dir() / name
-        if not name or not candidate.is_dir():
-            raise InputError("--rulebook", f"the trace was made with rulebook {name!r}, which is not "
-                             "shipped; pass its directory with --rulebook")
-        rulebook = candidate
+        return frame, _rulebook_of_trace(frame, source)
     return frame, load_rulebook(rulebook)
+
+
+def _rulebook_of_trace(frame, source: Path):
+    """The rulebook that made a trace, found without the user's help when possible.
+
+    Why: editing a copy of a shipped rulebook (``cp -r rulebooks/goal-frame mine``) keeps its
+    name, so looking the name up among the shipped rulebooks found the *original* and blamed a
+    ``--rulebook`` the user never passed. A trace written by ``plan --trace`` records the
+    directory (``rulebook_dir``) and every trace the sha256; the recorded directory is used when
+    its contents still hash to that sha256, else a shipped rulebook with that sha256; otherwise
+    one line says which directory changed (or which name is unknown) and that ``--rulebook DIR``
+    overrides.
+    """
+    name = str(frame["rulebook"].iloc[0]) if "rulebook" in frame and len(frame) else ""
+    sha = str(frame["rulebook_sha256"].iloc[0]) if len(frame) else ""
+    recorded = None
+    if "rulebook_dir" in frame and len(frame) and isinstance(frame["rulebook_dir"].iloc[0], str):
+        recorded = str(frame["rulebook_dir"].iloc[0]) or None
+    if recorded is not None and Path(recorded).is_dir():
+        rb = _load_or_none(Path(recorded))
+        if rb is not None and rb.sha256 == sha:
+            return rb
+        now = f"sha256 now {rb.sha256[:12]}…" if rb is not None else "it no longer loads"
+        raise InputError(str(source), f"rulebook_dir: the rulebook at {recorded} has changed since "
+                         f"it made this trace ({now}, the trace's {sha[:12]}…); pass the "
+                         "rulebook that made it with --rulebook DIR")
+    shipped = _shipped_with_sha(name, sha)
+    if shipped is not None:
+        return shipped
+    if recorded is not None:
+        raise InputError(str(source), f"rulebook_dir: {recorded}, the rulebook that made this "
+                         f"trace ({name!r}, sha256 {sha[:12]}…), no longer exists; pass it with "
+                         "--rulebook DIR")
+    raise InputError(str(source), f"rulebook: the trace was made with rulebook {name!r} (sha256 "
+                     f"{sha[:12]}…), which is not a shipped rulebook; pass its directory with "
+                     "--rulebook DIR")
+
+
+def _load_or_none(directory: Path):
+    from xfuzzy_rrt.errors import RulebookError
+
+    try:
+        return load_rulebook(directory)
+    except RulebookError:
+        return None
+
+
+def _shipped_with_sha(name: str, sha: str):
+    """The shipped rulebook whose contents hash to ``sha`` (the one named ``name`` first)."""
+    from xfuzzy_rrt.fuzzy.rulebook import list_rulebooks
+
+    candidates = sorted(list_rulebooks(), key=lambda p: p.name != name)
+    for directory in candidates:
+        rb = _load_or_none(directory)
+        if rb is not None and rb.sha256 == sha:
+            return rb
+    return None
 
 
 def _replay_result(path: Path, rulebook: Path | None):
@@ -51,11 +102,23 @@ def _replay_result(path: Path, rulebook: Path | None):
             raise InputError(str(path), f"{key}: missing; re-run 'xfuzzy-rrt plan' to get a result "
                              "that records it, or pass a trace file")
     scenario = load_scenario(data["scenario_file"])
-    rulebook_dir = rulebook if rulebook is not None else data["rulebook_dir"]
-    rb = load_rulebook(rulebook_dir)
-    if rb.sha256 != data["rulebook_sha256"]:
-        raise InputError(str(path), f"rulebook_sha256: the rulebook at {rulebook_dir} is not the "
-                         "one that made this result (it was edited or replaced)")
+    sha = str(data["rulebook_sha256"])
+    if rulebook is not None:
+        rb = load_rulebook(rulebook)
+        if rb.sha256 != sha:
+            raise InputError("--rulebook", f"the rulebook at {rulebook} (sha256 {rb.sha256[:12]}…) "
+                             f"is not the one that made {path} (sha256 {sha[:12]}…)")
+    else:
+        recorded = data["rulebook_dir"]
+        rb = _load_or_none(Path(recorded)) if recorded and Path(recorded).is_dir() else None
+        if rb is None or rb.sha256 != sha:
+            rb = _shipped_with_sha(str(data.get("rulebook") or ""), sha)
+        if rb is None:
+            state = ("has changed since it made this result" if recorded and Path(recorded).is_dir()
+                     else "no longer exists")
+            raise InputError(str(path), f"rulebook_dir: the rulebook at {recorded} {state} (sha256 "
+                             f"{sha[:12]}… recorded); pass the rulebook that made it with "
+                             "--rulebook DIR")
     max_iter = int(data.get("params", {}).get("max_iter", 10_000))
     result = plan_fuzzy_rrt(scenario, rb, seed=int(data["seed"]), max_iter=max_iter, trace=True)
     if result.iterations != data.get("iterations"):

@@ -16,6 +16,31 @@ import numpy as np
 
 _MASK = (1 << 64) - 1
 
+#: The largest seed any command accepts. :func:`seed_state` reads a seed's low 64 bits, but a
+#: seed is also a numba ``int64`` argument, an ``int64`` column of ``runs.csv`` and, for
+#: training, a ``SeedSequence`` entry kept below 2^63 (``TrainConfig``): one range, 0..2^63 - 1,
+#: keeps every consumer exact (a bench's ``seed + runs - 1`` included).
+SEED_MAX = (1 << 63) - 1
+
+
+def check_seed(seed, count: int = 1, where: str = "--seed") -> int:
+    """Return ``seed`` when ``seed .. seed + count - 1`` are all valid seeds, else raise one
+    :class:`~xfuzzy_rrt.errors.InputError` naming ``where`` and the valid range.
+
+    Why one check for every command: without it a seed of 2^64 reached numba as an untyped
+    integer (a TypingError traceback) and 10^23 overflowed a NumPy array."""
+    from xfuzzy_rrt.errors import InputError
+
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise InputError(where, f"must be an integer in 0..{SEED_MAX} (2^63 - 1), got {seed!r}")
+    seed = int(seed)
+    last = SEED_MAX - max(int(count), 1) + 1
+    if not 0 <= seed <= last:
+        runs = f" so that all {count} run seeds fit" if count > 1 else ""
+        raise InputError(where, f"must be an integer in 0..{last}{runs} (seeds are 0..2^63 - 1), "
+                         f"got {seed}")
+    return seed
+
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _rotl(x, k):

@@ -14,7 +14,9 @@ One row per iteration (``iteration`` = 1..iterations). Columns, in this order:
   ``sample_q1_deg``, ``sample_q2_deg``, ``new_q1_deg``, ``new_q2_deg``;
 - ``goal_sampled``, ``outcome`` (accepted, node_in_collision, edge_blocked, goal_reached,
   no_progress), ``on_path`` (the node added at this iteration lies on the returned path),
-  ``rulebook``, ``rulebook_sha256`` (which rulebook made these decisions);
+  ``rulebook``, ``rulebook_sha256`` (which rulebook made these decisions), and in a trace
+  written by ``plan --trace`` ``rulebook_dir`` (the absolute directory it was read from:
+  ``explain`` finds an edited copy there; :func:`with_rulebook_dir`);
 - with a rulebook of another semantics (e.g. ``goal-frame``) the input and output columns carry
   that semantics' names instead, and the box is the bounding box of its sampling region;
 - with more joints, one ``from_q<j>_deg``, ``box_q<j>_lo``/``_hi``, ``sample_q<j>_deg`` and
@@ -128,3 +130,16 @@ def trace_frame(buffers, iterations: int, nodes: np.ndarray, parent: np.ndarray,
         pd.DataFrame(buffers.rule[:n].reshape(n, -1).astype(np.int64), columns=rule_cols, copy=False),
         pd.DataFrame(buffers.w[:n].reshape(n, -1), columns=strength_cols, copy=False),
     ], axis=1)
+
+
+def with_rulebook_dir(frame: pd.DataFrame, directory) -> pd.DataFrame:
+    """``frame`` with a constant ``rulebook_dir`` column (absolute path) after
+    ``rulebook_sha256``; the input frame is not modified."""
+    from pathlib import Path
+
+    value = str(Path(directory).resolve())
+    out = frame.drop(columns=["rulebook_dir"], errors="ignore")
+    column = pd.Categorical.from_codes(np.zeros(len(out), dtype=np.int8),
+                                       dtype=_constant_dtype(value), validate=False)
+    out.insert(int(out.columns.get_loc("rulebook_sha256")) + 1, "rulebook_dir", column)
+    return out

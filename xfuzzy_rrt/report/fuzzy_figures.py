@@ -190,13 +190,48 @@ def partition_groups(rulebook) -> list[tuple[list[str], Any]]:
     return groups
 
 
+#: Term labels of a membership figure: the first row's height, the step between rows (data
+#: units of the 0..1 membership axis), the plotting width assumed for all subplots together
+#: (the report's 1400 px page less margins) and the width of one character at 10 px.
+LABEL_Y0 = 1.07
+LABEL_DY = 0.13
+LABEL_AXIS_PX = 1150.0
+LABEL_CHAR_PX = 6.5
+
+
+def label_rows(peaks: list[float], labels: list[str], axis_px: float) -> list[int]:
+    """A row (0, 1, ...) for each term label, centred on its peak, so that no two labels on
+    one row overlap: each label goes on the lowest row whose last label ends (with a 6 px
+    gap) before it starts. Why not alternate rows: trained peaks crowd (clearance_deg 0,
+    2.36, 5.57 of 30), and labels two terms apart then overlapped on the same row."""
+    lo, hi = float(peaks[0]), float(peaks[-1])
+    per_px = (hi - lo) / axis_px if hi > lo else 1.0
+    ends: list[float] = []
+    rows = []
+    for x, text in sorted(zip(peaks, labels), key=lambda t: t[0]):
+        half = 0.5 * len(text) * LABEL_CHAR_PX * per_px
+        left, right = float(x) - half, float(x) + half + 6.0 * per_px
+        row = next((r for r, end in enumerate(ends) if end <= left), len(ends))
+        if row == len(ends):
+            ends.append(right)
+        else:
+            ends[row] = right
+        rows.append(row)
+    order = sorted(range(len(peaks)), key=lambda j: peaks[j])
+    out = [0] * len(peaks)
+    for position, j in enumerate(order):
+        out[j] = rows[position]
+    return out
+
+
 def membership_figure(fis, outputs: list[str], rulebook=None) -> go.Figure:
     """The five terms of each input of ``fis`` (exact piecewise-linear, drawn through knots);
-    axis titles with units, term labels staggered on two rows so that neighbours never
-    overlap."""
+    axis titles with units, term labels on as many rows as needed so that none overlap
+    (:func:`label_rows`)."""
     units = semantics(rulebook)[4]
     fig = make_subplots(rows=1, cols=len(fis.inputs), horizontal_spacing=0.05)
     palette = ("#0072B2", "#009E73", "#E69F00", "#CC79A7", "#D55E00")
+    top = 1
     for c, inp in enumerate(fis.inputs):
         k = inp.peaks
         for j, term in enumerate(inp.terms):
@@ -211,12 +246,15 @@ def membership_figure(fis, outputs: list[str], rulebook=None) -> go.Figure:
                                      hovertemplate=plot_text(term)
                                      + " %{x:.4g}: %{y:.2f}<extra></extra>"),
                           row=1, col=c + 1)
-            fig.add_annotation(x=k[j], y=1.07 if j % 2 == 0 else 1.2,
-                               text=f"{plot_text(term)} {_sig(k[j])}", showarrow=False,
-                               font=dict(size=10, color=palette[j]),
+        labels = [f"{plot_text(term)} {_sig(k[j])}" for j, term in enumerate(inp.terms)]
+        rows = label_rows(list(k), labels, LABEL_AXIS_PX / len(fis.inputs))
+        top = max(top, max(rows))
+        for j, text in enumerate(labels):
+            fig.add_annotation(x=k[j], y=LABEL_Y0 + LABEL_DY * rows[j], text=text,
+                               showarrow=False, font=dict(size=10, color=palette[j]),
                                xref=f"x{c + 1}" if c else "x", yref=f"y{c + 1}" if c else "y")
         fig.update_xaxes(title_text=with_unit(inp.name, units), row=1, col=c + 1)
-    fig.update_yaxes(range=[0, 1.3], tickvals=[0, 0.5, 1])
+    fig.update_yaxes(range=[0, LABEL_Y0 + LABEL_DY * (top + 0.8)], tickvals=[0, 0.5, 1])
     fig.update_layout(template=TEMPLATE, height=300, margin=dict(l=40, r=30, t=60, b=45),
                       title=dict(text="Membership functions \u2014 " + plot_text(", ".join(outputs)),
                                  x=0))

@@ -61,6 +61,49 @@ def _remaining(path: np.ndarray, q: np.ndarray, index: int) -> np.ndarray:
     return np.vstack([q[None, :], path[index + 1:]])
 
 
+#: Why a replanning found no path (columns of a run's row, summed per table row):
+#: the arm's current configuration (the new start) is in collision with the moved obstacles;
+#: the goal is; or neither, and the planner used its whole ``max_iter`` budget.
+FAILURE_CAUSES = ("replan_fail_start_blocked", "replan_fail_goal_blocked",
+                  "replan_fail_budget")
+
+
+def _failure_cause(problem, q: np.ndarray, goal: np.ndarray) -> str:
+    from xfuzzy_rrt.geometry.collision import clearance_kernel
+
+    if clearance_kernel(problem, np.asarray(q, dtype=np.float64)) <= 0.0:
+        return "replan_fail_start_blocked"
+    if clearance_kernel(problem, np.asarray(goal, dtype=np.float64)) <= 0.0:
+        return "replan_fail_goal_blocked"
+    return "replan_fail_budget"
+
+
+def diagnosis(row) -> str | None:
+    """One sentence on why runs of a table row failed (``None`` when all succeeded): how the
+    runs ended and, with replanning, what stopped the replans. Why: "success 0.000 with 1,499
+    replan failures" alone does not say whether to raise ``--max-iter`` or expect a blocked
+    start."""
+    runs = int(row["runs"])
+    failed = runs - int(round(float(row["success_rate"]) * runs))
+    if failed == 0:
+        return None
+    ends = []
+    for key, what in (("runs_unplanned", "found no first plan"),
+                      ("runs_collided", "collided"),
+                      ("runs_timed_out", f"ran out of time ({row['time_limit_s']:g} s simulated)")):
+        if int(row.get(key, 0)):
+            ends.append(f"{int(row[key])} {what}")
+    text = f"{failed} of {runs} runs failed: " + ", ".join(ends or ["unknown"])
+    if int(row.get("replan_failures", 0)):
+        causes = [(int(row[c]), w) for c, w in (
+            ("replan_fail_start_blocked", "the arm's configuration was already in collision"),
+            ("replan_fail_goal_blocked", "the goal was in collision"),
+            ("replan_fail_budget", f"no path within {int(row['max_iter'])} iterations"))]
+        text += (f"; {int(row['replan_failures'])} replannings found no path: "
+                 + ", ".join(f"{n} {w}" for n, w in causes if n))
+    return text
+
+
 def execute_once(scenario, planner: str, seed: int, speed_m_s: float, joint_speed_deg_s: float,
                  rate_hz: float, replan: bool, max_iter: int = 10_000,
                  clearance_m: float | None = None, time_limit_s: float = 60.0) -> dict:
@@ -77,7 +120,8 @@ def execute_once(scenario, planner: str, seed: int, speed_m_s: float, joint_spee
                           clearance_m=clearance_m)
     row = {"seed": seed, "success": False, "collided": False, "replans": 0,
            "replan_failures": 0, "latency_median_s": math.nan, "latency_max_s": math.nan,
-           "time_s": math.nan, "planned": bool(first.path_deg.size)}
+           "time_s": math.nan, "planned": bool(first.path_deg.size), "timed_out": False,
+           **{cause: 0 for cause in FAILURE_CAUSES}}
     if not first.path_deg.size:
         return row
     path = np.asarray(first.path_deg, dtype=np.float64)
@@ -100,21 +144,27 @@ def execute_once(scenario, planner: str, seed: int, speed_m_s: float, joint_spee
                 row["replans"] += 1
                 t0 = time.perf_counter()
                 here = _scenario_at(scenario, obs_now, q)
+                r = None
                 try:
                     r = plan_scenario(here, planner=planner, seed=seed + row["replans"],
                                       max_iter=max_iter, clearance_m=clearance_m)
                 except InputError:
                     # An obstacle already came within the clearance of the arm: escape with a
                     # collision-free plan (no clearance) rather than stand still.
-                    r = plan_scenario(here, planner=planner, seed=seed + row["replans"],
-                                      max_iter=max_iter, clearance_m=0.0)
-                new = np.asarray(r.path_deg, dtype=np.float64)
+                    try:
+                        r = plan_scenario(here, planner=planner, seed=seed + row["replans"],
+                                          max_iter=max_iter, clearance_m=0.0)
+                    except InputError:
+                        r = None  # the start or the goal itself is in collision now
+                new = (np.asarray(r.path_deg, dtype=np.float64) if r is not None
+                       else np.zeros((0, a.dof)))
                 latencies.append(time.perf_counter() - t0)
                 if new.size:
                     path, index = new, 0
                     q = path[0].copy()
                 else:
                     row["replan_failures"] += 1
+                    row[_failure_cause(now, q, goal)] += 1
                     hold = True  # hold still this tick (obstacles may still run into the arm)
         # Advance the arm by one tick along the path.
         moved = np.array([q])
@@ -142,6 +192,8 @@ def execute_once(scenario, planner: str, seed: int, speed_m_s: float, joint_spee
             row["success"] = True
             row["time_s"] = t
             break
+    else:
+        row["timed_out"] = True
     if latencies:
         row["latency_median_s"] = float(np.median(latencies))
         row["latency_max_s"] = float(np.max(latencies))
@@ -173,6 +225,11 @@ def moving_obstacles(scenarios, planners, speeds, joint_speed_deg_s: float = 30.
                     "collision_rate": df["collided"].mean(),
                     "replans_mean": df["replans"].mean(),
                     "replan_failures": int(df["replan_failures"].sum()),
+                    "runs_unplanned": int((~df["planned"]).sum()),
+                    "runs_collided": int(df["collided"].sum()),
+                    "runs_timed_out": int(df["timed_out"].sum()),
+                    **{c: int(df[c].sum()) for c in FAILURE_CAUSES},
+                    "max_iter": int(max_iter), "time_limit_s": float(time_limit_s),
                     "latency_median_s": float(lat.median()) if len(lat) else math.nan,
                     "latency_max_s": float(df["latency_max_s"].max()) if len(lat) else math.nan,
                     "time_median_s": float(df["time_s"].median()),

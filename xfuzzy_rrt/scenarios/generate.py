@@ -8,8 +8,9 @@ problem must be worth planning:
   radius, joint limits ±180°), 2–7 obstacles (about 70 % circles of 2–6 cm radius, the rest
   axis-aligned boxes of 3–8 cm sides) placed 0.12–0.34 m from the base, i.e. inside the arm's
   reach, start and goal at whole degrees in [-170°, 170°];
-- **valid**: start and goal are collision-free with the planners' 1 µm margin, and the file
-  loads through the project's own validating loader;
+- **valid**: start and goal keep :data:`ENDPOINT_CLEARANCE_M` (5 mm, the family's link radius)
+  from every obstacle (and, with several arms, from the other arms), and the file loads through
+  the project's own validating loader;
 - **non-trivial**: the straight joint-space segment from start to goal is *not* certified free
   (otherwise one step of any planner solves it);
 - **solvable**: plain RRT finds a path within 20,000 iterations (seed 0) — a certified path is a
@@ -40,6 +41,12 @@ from xfuzzy_rrt.geometry.scenario import Arm, Box, Circle, Scenario
 from xfuzzy_rrt.scenarios.writer import scenario_toml  # noqa: F401  (re-exported)
 
 GRID_DEG = 2.0
+#: Clearance every generated start and goal keeps (metres): the links' 5 mm radius again.
+#: Why: with only the planners' 1 µm margin, ``gen-2000-020`` (a demo problem) had its goal
+#: 2.61 µm from an obstacle, so the demo's "closest approach" described the problem, not the
+#: planners, and a plan at a surgeon's clearance (``--clearance 0.005``) could not even start.
+#: Rulebooks trained before this (every shipped one) saw problems without it.
+ENDPOINT_CLEARANCE_M = 0.005
 RRT_BUDGET = 20_000
 MAX_DRAWS_PER_PROBLEM = 200
 
@@ -202,12 +209,12 @@ def grid_optimal_deg(scenario: Scenario, step_deg: float = GRID_DEG,
 
 
 def _config_ok(a, q) -> bool:
-    """Within the joint limits and farther than the planners' margin from every obstacle."""
+    """Within the joint limits and at least :data:`ENDPOINT_CLEARANCE_M` from every obstacle."""
     q = np.asarray(q, dtype=np.float64)
     lim = a.limits_deg
     if np.any(q < lim[:, 0]) or np.any(q > lim[:, 1]):
         return False
-    return clearance(a, q) > CERT_MARGIN_M
+    return clearance(a, q) >= max(ENDPOINT_CLEARANCE_M, CERT_MARGIN_M)
 
 
 def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample",
@@ -243,7 +250,7 @@ def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample",
         if segment_free(a, a.start_deg, a.goal_deg):
             continue  # trivial: the straight segment is free
         if not (_config_ok(a, a.start_deg) and _config_ok(a, a.goal_deg)):
-            continue  # free, but closer than the planners' margin
+            continue  # free, but closer than ENDPOINT_CLEARANCE_M
         if not plan_rrt(s, seed=0, max_iter=RRT_BUDGET).success:
             continue  # not shown solvable
         grid = c_space_grid(s)
@@ -373,7 +380,7 @@ def generate_nd(seed: int, k: int, prefix: str | None = None, dof: int = 3,
     Start and goal are whole degrees (joint 1 in [-170°, 170°], or [20°, 160°] facing the shared
     workspace; the others in [-120°, 120°]).
 
-    Kept only when valid (the loader accepts it; start and goal clear by the planners' margin,
+    Kept only when valid (the loader accepts it; start and goal clear by :data:`ENDPOINT_CLEARANCE_M`,
     arm-arm contact included), non-trivial (the straight joint segment is not certified free)
     and solvable: plain RRT (:func:`~xfuzzy_rrt.planners.api.plan_scenario`) returns a
     certified path for one of seeds :data:`ND_RRT_SEEDS` within :data:`ND_RRT_BUDGET`
@@ -399,7 +406,7 @@ def generate_nd(seed: int, k: int, prefix: str | None = None, dof: int = 3,
             continue  # start or goal in collision
         a = s.arrays()
         if not (_config_ok(a, a.start_deg) and _config_ok(a, a.goal_deg)):
-            continue  # free, but closer than the planners' margin
+            continue  # free, but closer than ENDPOINT_CLEARANCE_M
         if segment_free(a, a.start_deg, a.goal_deg):
             continue  # trivial: the straight segment is free
         proof = _rrt_proof(s)

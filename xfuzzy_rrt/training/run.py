@@ -351,6 +351,10 @@ def run_training(job: TrainJob,
             on_start(evaluator.description, state.generation)
         if state.history:
             write_history(history_path, state.history)
+        # compile and start the workers before generation 1 is timed (its runs/s)
+        for engine in (evaluator, validator):
+            if engine is not None and hasattr(engine, "warm_up") and len(state.population):
+                engine.warm_up(state.population[:1])
         trainer = Trainer(config, evaluator, on_generation=checkpoint, on_chunk=on_chunk,
                           validator=validator)
         state = trainer.run(state)

@@ -77,6 +77,10 @@ def _init_worker(problems: list[TrainingProblem], parent_pid: int) -> None:
                    "absolute", np.zeros(1, dtype=np.int64), 5)
 
 
+def _warm_in_worker(genes, bounds_mode, dof):
+    evaluate_chunk(genes, _PROBLEMS[:1], bounds_mode, np.zeros(1, dtype=np.int64), 5, dof)
+
+
 def _evaluate_in_worker(genes, bounds_mode, seeds, max_iter, dof=2):
     return evaluate_chunk(genes, _PROBLEMS, bounds_mode, seeds, max_iter, dof)
 
@@ -101,6 +105,13 @@ class Evaluator:
         self.dof = int(dof)  # the rulebook DOF the genomes encode
 
     description = "in-process"
+
+    def warm_up(self, genes: np.ndarray) -> None:
+        """Compile (or load from numba's cache) the kernels for these genes' semantics here,
+        before anything is timed. Why: generation 1's ``runs_per_s`` used to include the first
+        compile and read "0 runs/s"."""
+        evaluate_chunk(np.asarray(genes[:1]), self.problems[:1], self.bounds_mode,
+                       np.zeros(1, dtype=np.int64), 5, self.dof)
 
     def __call__(self, genes: np.ndarray, seeds: np.ndarray,
                  progress: Callable[[int, int], None] | None = None) -> np.ndarray:
@@ -143,6 +154,15 @@ class ProcessEvaluator(Evaluator):
             if progress:
                 progress(k, len(parts))
         return out
+
+    def warm_up(self, genes: np.ndarray) -> None:
+        """Compile here first (the workers then load numba's cache), then start every worker
+        and load the kernels in it, so that no timed generation pays for either."""
+        super().warm_up(genes)
+        futures = [self._pool.submit(_warm_in_worker, np.asarray(genes[:1]), self.bounds_mode,
+                                     self.dof) for _ in range(self.workers)]
+        for fut in futures:
+            fut.result()
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)

@@ -10,12 +10,16 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.result import PlanResult
 
-PLANNERS = ("rrt", "fuzzy-rrt")
+PLANNERS = ("rrt", "fuzzy-rrt", "fuzzy-rrt-connect")
 TRACE_SUFFIXES = (".parquet", ".csv")
 #: ``ompl:NAME`` runs OMPL's geometric planner NAME (optional extra; see planners/ompl_bridge.py).
 OMPL_PREFIX = "ompl:"
 #: ``fuzzy-rrt:NAME`` (a shipped rulebook) or ``fuzzy-rrt:DIR`` (a rulebook directory).
 FUZZY_PREFIX = "fuzzy-rrt:"
+#: ``fuzzy-rrt-connect:NAME|DIR``: Fuzzy-RRT-Connect with that goal-frame rulebook.
+CONNECT_PREFIX = "fuzzy-rrt-connect:"
+#: Planner kinds that take a rulebook (and can record traces).
+RULEBOOK_KINDS = ("fuzzy-rrt", "fuzzy-rrt-connect")
 
 
 @dataclass(frozen=True)
@@ -23,9 +27,10 @@ class PlannerSpec:
     """One planner as the user wrote it.
 
     ``label`` is the text itself (``"fuzzy-rrt:paper"``): it names the planner in every table
-    so that several rulebooks can stand side by side. ``kind`` is ``rrt``, ``fuzzy-rrt`` or
-    ``ompl``; ``rulebook_dir`` is the directory a ``fuzzy-rrt:...`` label names (``None`` for
-    plain ``fuzzy-rrt``: the caller's rulebook or the shipped default).
+    so that several rulebooks can stand side by side. ``kind`` is ``rrt``, ``fuzzy-rrt``,
+    ``fuzzy-rrt-connect`` or ``ompl``; ``rulebook_dir`` is the directory a ``fuzzy-rrt:...``
+    or ``fuzzy-rrt-connect:...`` label names (``None`` for the plain names: the caller's
+    rulebook or the planner's shipped default).
     """
 
     label: str
@@ -37,7 +42,19 @@ def is_known_planner(name: str) -> bool:
     """A built-in planner name, ``fuzzy-rrt:...`` or ``ompl:NAME`` (the part after the colon
     is checked by :func:`parse_planner`). Cheap and import-free, for argument parsing."""
     return name in PLANNERS or any(name.startswith(p) and len(name) > len(p)
-                                   for p in (OMPL_PREFIX, FUZZY_PREFIX))
+                                   for p in (OMPL_PREFIX, FUZZY_PREFIX, CONNECT_PREFIX))
+
+
+def default_rulebook_dir(kind: str) -> Path:
+    """The shipped rulebook a planner kind uses without one: the default rulebook for
+    ``fuzzy-rrt``, the goal-frame rulebook for ``fuzzy-rrt-connect`` (it needs that semantics)."""
+    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, rulebooks_dir
+
+    if kind == "fuzzy-rrt-connect":
+        from xfuzzy_rrt.planners.connect import DEFAULT_RULEBOOK
+
+        return rulebooks_dir() / DEFAULT_RULEBOOK
+    return default_rulebook_path()
 
 
 def shipped_rulebook_names() -> list[str]:
@@ -46,7 +63,7 @@ def shipped_rulebook_names() -> list[str]:
     return [p.name for p in list_rulebooks()]
 
 
-def rulebook_dir_of(arg: str, where: str) -> Path:
+def rulebook_dir_of(arg: str, where: str, prefix: str = FUZZY_PREFIX) -> Path:
     """The directory ``fuzzy-rrt:ARG`` names.
 
     A bare word is a shipped rulebook (``general``, ``paper``, ...); anything with a path
@@ -64,9 +81,9 @@ def rulebook_dir_of(arg: str, where: str) -> Path:
     path = rulebooks_dir() / arg
     if not path.is_dir():
         names = shipped_rulebook_names()
-        raise InputError(where, f"unknown rulebook {arg!r} in {FUZZY_PREFIX}{arg} (shipped: "
+        raise InputError(where, f"unknown rulebook {arg!r} in {prefix}{arg} (shipped: "
                          f"{', '.join(names) or 'none'}; a directory needs a '/', e.g. "
-                         f"{FUZZY_PREFIX}./{arg})")
+                         f"{prefix}./{arg})")
     return path
 
 
@@ -81,13 +98,17 @@ def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
         return PlannerSpec(name, name)
     if name.startswith(FUZZY_PREFIX) and len(name) > len(FUZZY_PREFIX):
         return PlannerSpec(name, "fuzzy-rrt", rulebook_dir_of(name[len(FUZZY_PREFIX):], where))
+    if name.startswith(CONNECT_PREFIX) and len(name) > len(CONNECT_PREFIX):
+        return PlannerSpec(name, "fuzzy-rrt-connect",
+                           rulebook_dir_of(name[len(CONNECT_PREFIX):], where, CONNECT_PREFIX))
     if name.startswith(OMPL_PREFIX) and len(name) > len(OMPL_PREFIX):
         from xfuzzy_rrt.planners.ompl_bridge import check_ompl_planner
 
         check_ompl_planner(name, where)
         return PlannerSpec(name, "ompl")
     raise InputError(where, f"unknown planner {name!r} (expected one of "
-                     f"{', '.join(PLANNERS)}, {FUZZY_PREFIX}RULEBOOK or {OMPL_PREFIX}NAME)")
+                     f"{', '.join(PLANNERS)}, {FUZZY_PREFIX}RULEBOOK, {CONNECT_PREFIX}RULEBOOK or "
+                     f"{OMPL_PREFIX}NAME)")
 
 
 def check_planner(name: str, where: str = "--planners") -> str:
@@ -101,8 +122,8 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
                   max_time_s: float | None = None) -> PlanResult:
     """Plan ``scenario`` with the named planner (a label :func:`parse_planner` accepts).
 
-    ``rulebook`` (fuzzy-rrt only) is a loaded rulebook, a directory path, or ``None`` for the
-    shipped default, or for the one a ``fuzzy-rrt:NAME`` label names. ``step_deg``/``goal_bias``
+    ``rulebook`` (fuzzy-rrt and fuzzy-rrt-connect) is a loaded rulebook, a directory path, or
+    ``None`` for the planner's shipped default, or for the one a ``...:NAME`` label names. ``step_deg``/``goal_bias``
     configure plain RRT and the OMPL planners (range and goal bias where they have one);
     Fuzzy-RRT takes both from its rulebook. ``ompl:NAME`` runs OMPL's geometric planner NAME
     with our collision checker (:func:`xfuzzy_rrt.planners.ompl_bridge.plan_ompl`; needs the
@@ -112,23 +133,26 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     :mod:`xfuzzy_rrt.planners.termination`).
     """
     spec = parse_planner(planner, "--planner")
-    if spec.kind != "fuzzy-rrt" and trace:
-        raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt")
+    if spec.kind not in RULEBOOK_KINDS and trace:
+        raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt "
+                         "or fuzzy-rrt-connect")
     if spec.kind == "rrt":
         from xfuzzy_rrt.planners.rrt import plan_rrt
 
         return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
                         goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
-    if spec.kind == "fuzzy-rrt":
-        from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
-
+    if spec.kind in RULEBOOK_KINDS:
         if spec.rulebook_dir is not None:
             if rulebook is not None and not _same_rulebook(rulebook, spec.rulebook_dir):
                 raise InputError("--rulebook", f"conflicts with --planner {spec.label} (which "
                                  "names its own rulebook); give only one")
             rulebook = rulebook if rulebook is not None else spec.rulebook_dir
-        result = plan_fuzzy_rrt(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
-                                trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
+        if spec.kind == "fuzzy-rrt-connect":
+            from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect as plan_fuzzy
+        else:
+            from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt as plan_fuzzy
+        result = plan_fuzzy(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
+                            trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
         return dataclasses.replace(result, planner=spec.label)
     from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 

@@ -42,13 +42,76 @@ def _oracle_ok(s, r):
 def test_two_joint_connect_paths_pass_the_oracle_with_the_goal_frame_rulebook(path):
     s = load_scenario(path)
     for seed in range(3):
-        r = plan_scenario(s, "fuzzy-rrt-connect", seed=seed, max_iter=20_000)
-        assert r.planner == "fuzzy-rrt-connect" and r.rulebook == "goal-frame"
+        r = plan_scenario(s, "fuzzy-rrt-connect:goal-frame", seed=seed, max_iter=20_000)
+        assert r.planner == "fuzzy-rrt-connect:goal-frame" and r.rulebook == "goal-frame"
         _oracle_ok(s, r)
 
 
-CASES = [(single_arm(3, 0), "goal-frame-3dof"), (single_arm(5, 0), "goal-frame-5dof"),
-         (single_arm(5, 1), "goal-frame-5dof"), (single_arm(7, 0), "goal-frame-7dof"),
+@pytest.mark.parametrize("path", TWO_JOINTS, ids=lambda p: p.stem)
+def test_at_two_joints_the_dof_free_default_decides_exactly_as_goal_frame(path):
+    s = load_scenario(path)
+    for seed in range(3):
+        a = plan_scenario(s, "fuzzy-rrt-connect", seed=seed)
+        b = plan_scenario(s, "fuzzy-rrt-connect:goal-frame", seed=seed)
+        assert a.rulebook == "goal-frame-any" and a.params["length_scale"] == 1.0
+        assert a.path_deg.tobytes() == b.path_deg.tobytes()
+        assert a.tree_nodes_deg.tobytes() == b.tree_nodes_deg.tobytes()
+        _oracle_ok(s, a)
+
+
+ANY_ARM = [single_arm(3, 0), single_arm(4, 0), single_arm(6, 0), single_arm(7, 0),
+           single_arm(7, 1), dual_arm(2, 0), dual_arm(3, 0), dual_arm(3, 1)]
+
+
+@pytest.mark.parametrize("s", ANY_ARM, ids=lambda s: s.name)
+def test_the_default_plans_any_arm_without_a_rulebook_and_the_oracle_agrees(s):
+    for seed in range(2):
+        r = plan_scenario(s, "fuzzy-rrt-connect", seed=seed, max_iter=20_000)
+        assert r.rulebook == "goal-frame-any"
+        assert r.params["length_scale"] == pytest.approx((s.dof / 2) ** 0.5)
+        _oracle_ok(s, r)
+
+
+@pytest.mark.parametrize("path", sorted((FIXTURES / "many-arms").glob("*.toml")),
+                         ids=lambda p: p.stem)
+def test_the_default_plans_three_and_four_arms(path):
+    # written by ``xfuzzy-rrt scenarios generate --seed 9500 --arms 3`` (and ``--arms 4``)
+    s = load_scenario(path)
+    assert len(s.arms) in (3, 4)
+    for seed in range(2):
+        r = plan_scenario(s, "fuzzy-rrt-connect", seed=seed, max_iter=20_000)
+        _oracle_ok(s, r)
+
+
+def test_fuzzy_rrt_refuses_a_dof_free_rulebook_in_one_line():
+    s = load_scenario(TWO_JOINTS[0])
+    with pytest.raises(InputError, match="fuzzy-rrt-connect"):
+        plan_scenario(s, "fuzzy-rrt:goal-frame-any")
+
+
+def test_a_dof_free_manifest_must_say_dof_any_and_only_it_may(tmp_path):
+    import shutil
+
+    from xfuzzy_rrt.errors import RulebookError
+
+    src = rulebooks_dir() / "goal-frame-any"
+    assert 'dof = "any"' in (src / "rulebook.toml").read_text()
+    bad = tmp_path / "bad"
+    shutil.copytree(src, bad)
+    m = bad / "rulebook.toml"
+    m.write_text(m.read_text().replace('dof = "any"', "dof = 5"))
+    with pytest.raises(RulebookError, match='write dof = "any"'):
+        load_rulebook(bad)
+    gf = tmp_path / "gf"
+    shutil.copytree(rulebooks_dir() / "goal-frame", gf)
+    m = gf / "rulebook.toml"
+    m.write_text(m.read_text().replace('semantics = "goal-frame"\n',
+                                       'semantics = "goal-frame"\ndof = "any"\n'))
+    with pytest.raises(RulebookError, match="needs a DOF-free semantics"):
+        load_rulebook(gf)
+
+
+CASES = [(single_arm(5, 0), "goal-frame-5dof"), (single_arm(5, 1), "goal-frame-5dof"),
          (dual_arm(3, 0), "goal-frame-dual3"), (dual_arm(3, 1), "goal-frame-dual3")]
 
 
@@ -102,7 +165,7 @@ def test_iterations_count_loop_iterations_not_connect_steps():
 def test_explain_reproduces_every_recorded_output_of_a_connect_trace(tmp_path):
     s = load_scenario(TWO_JOINTS[1])
     r = plan_fuzzy_rrt_connect(s, seed=2, trace=True)
-    rb = load_rulebook(rulebooks_dir() / "goal-frame")
+    rb = load_rulebook(rulebooks_dir() / r.rulebook)
     for it in sorted({1, 2, r.iterations // 2 + 1, r.iterations}):
         e = explain_row(trace_row(r.trace, it), rb)
         assert e.max_discrepancy < 1e-12
@@ -127,7 +190,7 @@ def test_explain_reproduces_every_recorded_output_of_a_connect_trace(tmp_path):
 
 def test_a_paper_semantics_rulebook_is_refused_in_one_line():
     s = load_scenario(TWO_JOINTS[0])
-    with pytest.raises(InputError, match="needs a goal-frame rulebook"):
+    with pytest.raises(InputError, match="needs a goal-frame or goal-frame-any rulebook"):
         plan_scenario(s, "fuzzy-rrt-connect:paper")
 
 

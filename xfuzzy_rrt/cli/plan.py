@@ -19,7 +19,7 @@ def plan(
     planner: str = typer.Option(
         PlannerName.fuzzy_rrt.value, "--planner",
         help="Planner: rrt, fuzzy-rrt, fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, "
-             "fuzzy-rrt-connect[:NAME|:DIR] (two goal-frame trees; default rulebook goal-frame), or "
+             "fuzzy-rrt-connect[:NAME|:DIR] (two goal-frame trees; default rulebook goal-frame-any, any arm), or "
              "ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
     rulebook: Optional[Path] = typer.Option(
         None, "--rulebook", help="Rulebook directory (fuzzy-rrt, fuzzy-rrt-connect; default: the planner's shipped default)."),

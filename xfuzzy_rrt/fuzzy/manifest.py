@@ -198,7 +198,9 @@ def format_manifest(m: Manifest) -> str:
     ]
     if m.semantics != _sem.PAPER.name:
         lines.append(f"semantics = {_toml_string(m.semantics)}")
-    if m.dof != _sem.DEFAULT_DOF:
+    if _sem.get(m.semantics, m.dof).dof_free:
+        lines.append(f"dof = {_toml_string(_sem.ANY_DOF)}")
+    elif m.dof != _sem.DEFAULT_DOF:
         lines.append(f"dof = {m.dof}")
     if m.bounds_mode is not None:
         lines.append(f"bounds_mode = {_toml_string(m.bounds_mode)}")
@@ -283,6 +285,16 @@ def parse_manifest(data: bytes, file: str) -> tuple[Manifest | None, list[Proble
         problem("semantics", f"semantics must be one of {', '.join(map(repr, _sem.SEMANTICS))}, got {sem_name!r}")
         sem_name = _sem.PAPER.name
     dof = doc.get("dof", _sem.DEFAULT_DOF)
+    if _sem.SEMANTICS[sem_name].dof_free:  # one rulebook for every arm: it says so
+        if dof != _sem.ANY_DOF:
+            problem("dof", f'a {sem_name} rulebook plans any arm: write dof = "{_sem.ANY_DOF}"'
+                    + (f", not {dof!r}" if "dof" in doc else ""))
+        dof = _sem.DEFAULT_DOF
+    elif dof == _sem.ANY_DOF:
+        problem("dof", f'dof = "{_sem.ANY_DOF}" needs a DOF-free semantics '
+                f"({', '.join(n for n, s in _sem.SEMANTICS.items() if s.dof_free)}); "
+                f"a {sem_name} rulebook is for one number of joints")
+        dof = _sem.DEFAULT_DOF
     dof_problem = _sem.dof_problem(dof)
     if dof_problem:
         problem("dof", dof_problem)

@@ -16,7 +16,7 @@ TRACE_SUFFIXES = (".parquet", ".csv")
 OMPL_PREFIX = "ompl:"
 #: ``fuzzy-rrt:NAME`` (a shipped rulebook) or ``fuzzy-rrt:DIR`` (a rulebook directory).
 FUZZY_PREFIX = "fuzzy-rrt:"
-#: ``fuzzy-rrt-connect:NAME|DIR``: Fuzzy-RRT-Connect with that goal-frame rulebook.
+#: ``fuzzy-rrt-connect:NAME|DIR``: Fuzzy-RRT-Connect with that goal-frame(-any) rulebook.
 CONNECT_PREFIX = "fuzzy-rrt-connect:"
 #: Planner kinds that take a rulebook (and can record traces).
 RULEBOOK_KINDS = ("fuzzy-rrt", "fuzzy-rrt-connect")
@@ -47,7 +47,7 @@ def is_known_planner(name: str) -> bool:
 
 def default_rulebook_dir(kind: str) -> Path:
     """The shipped rulebook a planner kind uses without one: the default rulebook for
-    ``fuzzy-rrt``, the goal-frame rulebook for ``fuzzy-rrt-connect`` (it needs that semantics)."""
+    ``fuzzy-rrt``, the DOF-free ``goal-frame-any`` for ``fuzzy-rrt-connect`` (any arm)."""
     from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, rulebooks_dir
 
     if kind == "fuzzy-rrt-connect":

@@ -34,6 +34,13 @@ iteration: iteration 1 grows the start tree, iteration 2 the goal tree, ...):
    with ``P.margin`` and every node by ``config_free``; the junction is one configuration held
    by both trees, so no uncertified edge joins them.
 
+**Rulebooks.** A ``goal-frame`` rulebook (its DOF = the problem's joints in all) or a DOF-free
+``goal-frame-any`` one, the default (the shipped ``goal-frame-any``): its lengths are normalised
+degrees, so the kernel divides the distance and clearance inputs by ``scale = sqrt(N/2)`` (``N``
+joints in all) and multiplies the box and step outputs by it; at 2 joints ``scale`` is exactly
+1 and the run is bit for bit the goal-frame one. The paper's semantics is refused: its box is
+absolute or relative to one node, and cannot point at another tree.
+
 The path is the start tree's path to the junction followed by the goal tree's path from the
 junction, reversed; it begins exactly at the start and ends exactly at the goal.
 
@@ -65,6 +72,7 @@ import numpy as np
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.engine import infer
+from xfuzzy_rrt.fuzzy.semantics import length_scale
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.collision import clearance_kernel
@@ -92,8 +100,9 @@ from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
 
 PLANNER = "fuzzy-rrt-connect"
-#: The rulebook used without one: the shipped goal-frame rulebook.
-DEFAULT_RULEBOOK = "goal-frame"
+#: The rulebook used without one: the shipped DOF-free rulebook (any arm; at 2 joints it decides
+#: exactly as the goal-frame rulebook).
+DEFAULT_RULEBOOK = "goal-frame-any"
 START_TREE = 0
 GOAL_TREE = 1
 
@@ -112,8 +121,8 @@ def _same(a, b):
 
 
 @nb.njit(cache=True, nogil=True)
-def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, min_step, stop, record, TR,
-                   grown, connect_nodes, counts):
+def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
+                   TR, grown, connect_nodes, counts):
     """Run Fuzzy-RRT-Connect; return ``(success, iterations, junction node in TA, junction
     node in TB)`` (-1, -1 on failure). The two junction nodes hold the same configuration.
 
@@ -121,7 +130,9 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, min_step, stop,
     view: its extension joins the start directly when it can); ``TA``/``TB`` the empty start
     and goal trees. With ``record`` true, row ``it - 1`` of ``TR``, ``grown`` and
     ``connect_nodes`` describes iteration ``it``. ``counts[0]`` receives the number of
-    extensions attempted. ``stop[0] != 0`` ends the run.
+    extensions attempted. ``stop[0] != 0`` ends the run. ``scale``: Euclidean degrees per
+    unit of the rulebook's lengths (1 for goal-frame, ``sqrt(N/2)`` for goal-frame-any): the
+    distance and clearance inputs are divided by it, the box and step outputs multiplied.
     """
     state = np.empty(4, dtype=np.uint64)
     seed_state(seed, state)
@@ -129,6 +140,7 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, min_step, stop,
     dof = P.start.shape[0]
     x = np.empty(4, dtype=np.float64)
     y = np.empty(n_out, dtype=np.float64)
+    ys = np.empty(n_out, dtype=np.float64)
     dummy_rule = np.empty((n_out, MAX_FIRED), dtype=np.int32)
     dummy_w = np.empty((n_out, MAX_FIRED), dtype=np.float64)
     box = np.empty(2 * dof, dtype=np.float64)
@@ -181,20 +193,24 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, min_step, stop,
         d_target = _joint_dist(q, target)
         if has_obstacles:
             c = clearance_kernel(P, q)
-            c_deg = max(c, 0.0) * deg_per_m
+            c_in = max(c, 0.0) * deg_per_m / scale
         else:
-            c_deg = clear_top
-        x[0] = d_target
+            c_in = clear_top
+        x[0] = d_target / scale
         x[1] = stagnation
-        x[2] = c_deg
+        x[2] = c_in
         x[3] = reject[g]
         if record:
             infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
         else:
             infer(knots, consts, x, y, dummy_rule, dummy_w, False)
-        step = max(y[5], min_step)
+        ys[0] = y[0]
+        ys[1] = y[1]
+        for k in range(2, n_out):  # lengths back to joint-space degrees
+            ys[k] = y[k] * scale
+        step = max(ys[5], min_step)
         # 3. sample in the box pointing at the target
-        target_sampled = sample_goal_frame(q, target, d_target, y, limits, state, sample, box, e)
+        target_sampled = sample_goal_frame(q, target, d_target, ys, limits, state, sample, box, e)
         # 4. grow
         near = nearest(G, sample)
         current[g] = near
@@ -251,7 +267,7 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, min_step, stop,
 
 
 def _resolve_rulebook(rulebook):
-    """A loaded rulebook as given, else the (cached) directory, else the shipped goal-frame."""
+    """A loaded rulebook as given, else the (cached) directory, else the shipped default."""
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached, rulebooks_dir
 
     if rulebook is None:
@@ -262,16 +278,18 @@ def _resolve_rulebook(rulebook):
 
 
 def check_connect_rulebook(rb, scenario: Scenario) -> None:
-    """One clear error unless *rb* is a goal-frame rulebook of the problem's total DOF: the
-    connect kernel points the goal-frame box at the other tree, which the paper's workspace
-    semantics cannot express."""
+    """One clear error unless *rb* is a goal-frame rulebook of the problem's total DOF or a
+    DOF-free goal-frame-any one: the connect kernel points the goal-frame box at the other
+    tree, which the paper's workspace semantics cannot express."""
     from xfuzzy_rrt.planners.fuzzy_rrt import check_rulebook_fits
 
-    if rb.semantics.name != "goal-frame":
+    if rb.semantics.name not in ("goal-frame", "goal-frame-any"):
         raise InputError(scenario.source or scenario.name,
                          f"rulebook {rb.name!r} has the {rb.semantics.name!r} semantics; "
-                         f"{PLANNER} needs a goal-frame rulebook (e.g. {DEFAULT_RULEBOOK})")
-    check_rulebook_fits(rb, scenario)
+                         f"{PLANNER} needs a goal-frame or goal-frame-any rulebook (e.g. "
+                         f"{DEFAULT_RULEBOOK})")
+    if not rb.semantics.dof_free:  # a goal-frame-any rulebook plans every arm
+        check_rulebook_fits(rb, scenario)
 
 
 def merged_tree(nodes_a, parent_a, nodes_b, parent_b):
@@ -297,8 +315,9 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
                            max_time_s: float | None = None) -> PlanResult:
     """Plan with Fuzzy-RRT-Connect (see the module docstring).
 
-    ``rulebook``: a loaded goal-frame rulebook, a rulebook directory, or ``None`` for the
-    shipped ``goal-frame``; its DOF must be the problem's total number of joints. Other
+    ``rulebook``: a loaded goal-frame or goal-frame-any rulebook, a rulebook directory, or
+    ``None`` for the shipped ``goal-frame-any`` (any arm); a goal-frame rulebook's DOF must be
+    the problem's total number of joints. Other
     arguments as for :func:`~xfuzzy_rrt.planners.fuzzy_rrt.plan_fuzzy_rrt`.
     """
     check_dof(scenario)
@@ -310,6 +329,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     rb = _resolve_rulebook(rulebook)
     check_connect_rulebook(rb, scenario)
     knots, consts = rb.compiled
+    scale = length_scale(rb.semantics, scenario.dof)
     a = scenario.arrays()
     problem = a.problem(margin)
     reverse = problem._replace(start=problem.goal, goal=problem.start)
@@ -324,7 +344,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
 
     def run(iters, stop):
         return connect_kernel(problem, reverse, ta, tb, int(seed), int(iters), knots, consts,
-                              min_step, stop, bool(trace), buffers, grown, connect_nodes, counts)
+                              scale, min_step, stop, bool(trace), buffers, grown, connect_nodes, counts)
 
     if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
         meta_a, meta_b = ta.meta.copy(), tb.meta.copy()
@@ -342,7 +362,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     from xfuzzy_rrt.planners.result import certified_result  # certifies the path (found -> success)
 
     recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
-                "min_step_deg": min_step, "margin_m": float(margin),
+                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale,
                 "extensions": int(counts[0]), "start_tree_nodes": na, "goal_tree_nodes": nb_}
     if max_time_s is not None:
         recorded["max_time_s"] = float(params["max_time_s"])
@@ -356,13 +376,13 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     )
     if trace:
         frame = _trace_frame(buffers, grown, connect_nodes, int(iterations), nodes, parent, na,
-                             int(last_a), int(last_b) + na if ok else -1, rb, min_step)
+                             int(last_a), int(last_b) + na if ok else -1, rb, min_step, scale)
         result = dataclasses.replace(result, trace=frame)
     return result
 
 
 def _trace_frame(buffers, grown, connect_nodes, n, nodes, parent, na, last_a, last_b, rb,
-                 min_step):
+                 min_step, scale):
     """The goal-frame trace frame with merged-tree node indices, ``on_path`` over both trees,
     and the ``tree``/``connect_nodes`` columns appended."""
     from xfuzzy_rrt.planners.trace import trace_frame
@@ -383,6 +403,8 @@ def _trace_frame(buffers, grown, connect_nodes, n, nodes, parent, na, last_a, la
     on_path = np.zeros(n, dtype=bool)
     on_path[added] = on_path_nodes[new_node[added]]
     frame["on_path"] = on_path
+    if scale != 1.0:  # the recorded outputs are the rulebook's (normalised) values
+        frame["step_used_deg"] = np.maximum(buffers.y[:n, -1] * scale, min_step)
     frame["tree"] = grown[:n].astype(np.int64)
     frame["connect_nodes"] = connect_nodes[:n].copy()
     return frame

@@ -217,3 +217,20 @@ def test_cli_wrong_rulebook_is_one_line_exit_2(tmp_path):
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and "goal-frame" in lines[0]
     assert not out.exists()
+
+
+def test_a_dof_free_trace_records_the_rulebook_values_and_the_degrees_used():
+    s = single_arm(4, 0)
+    r = plan_fuzzy_rrt_connect(s, seed=1, trace=True, max_iter=20_000)
+    t = r.trace
+    scale = r.params["length_scale"]
+    assert scale == pytest.approx(2 ** 0.5)
+    # outputs as the rulebook gave them (explain recomputes them); the step in joint degrees
+    assert np.allclose(t["step_used_deg"], np.maximum(t["step_deg"] * scale, 0.5))
+    rb = load_rulebook(rulebooks_dir() / "goal-frame-any")
+    for it in sorted({1, 2, r.iterations}):
+        assert explain_row(trace_row(t, it), rb).max_discrepancy < 1e-12
+    # the distance input is the normalised distance from the current node to the target
+    row = t.iloc[0]
+    d = np.linalg.norm(np.asarray(s.goal_deg) - np.asarray(s.start_deg))
+    assert row["norm_dist_to_goal"] == pytest.approx(d / scale)

@@ -234,3 +234,13 @@ def test_a_dof_free_trace_records_the_rulebook_values_and_the_degrees_used():
     row = t.iloc[0]
     d = np.linalg.norm(np.asarray(s.goal_deg) - np.asarray(s.start_deg))
     assert row["norm_dist_to_goal"] == pytest.approx(d / scale)
+
+
+def test_a_dof_free_rulebook_round_trips_through_fll(tmp_path):
+    from xfuzzy_rrt.fuzzy.fll import export_fll, import_fll
+
+    rb = load_rulebook(rulebooks_dir() / "goal-frame-any")
+    export_fll(rb, tmp_path / "fll")
+    back = import_fll(tmp_path / "fll")
+    assert back.semantics is rb.semantics and back.semantics.dof_free
+    assert all((a == b).all() for a, b in zip(back.arrays(), rb.arrays()))

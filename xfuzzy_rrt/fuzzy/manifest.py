@@ -25,7 +25,8 @@ degrees (the paper's reading) or ``"relative"`` offsets from the current nearest
 ``dof`` (an integer 2..7, the arm's joints) is written only when it is not 2, so every 2-DOF
 manifest keeps its bytes and its SHA-256; a missing key means 2. It fixes the FIS files the
 directory must hold (see :mod:`.semantics`: a paper rulebook of ``dof = 5`` has
-``bound_1.fis … bound_10.fis``).
+``bound_1.fis … bound_10.fis``). A DOF-free semantics (``goal-frame-any``) writes ``dof = "any"``
+instead, and requires it: its rulebook plans every arm.
 
 ``provenance`` records what produced the rulebook: at least ``kind`` (e.g. ``"hand-written"``,
 ``"ga"``, ``"imported-fll"``), typically also ``command``, ``seed``, ``fitness``,

@@ -40,6 +40,14 @@ rulebook changes. What depends on ``N``:
   its dimension); only ``joint_dist_to_goal``'s range grows to ``[0, 180*sqrt(2N)]`` degrees,
   the diagonal of a joint space of N joints of 360° each (scaled so that N = 2 gives exactly
   the 360 it always had). For several arms, N is the total number of joints planned together.
+
+``goal-frame-any`` — goal-frame for any arm (manifest ``dof = "any"``; :attr:`Semantics.dof_free`):
+the same four inputs and six outputs, renamed (input names are unique across semantics) and
+with every joint-space length (distance, clearance, ahead, behind, side, step) in *normalised
+degrees*: Euclidean joint-space degrees divided by ``sqrt(N/2)`` (:func:`length_scale`). At
+N = 2 every number is goal-frame's; at other N the ranges still hold (the distance range
+``180*sqrt(2N)`` normalises to 360), so one rulebook plans 2 to 7 joints and several arms.
+Only Fuzzy-RRT-Connect (:mod:`xfuzzy_rrt.planners.connect`) plans with it so far.
 """
 
 from __future__ import annotations

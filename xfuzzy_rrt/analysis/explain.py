@@ -187,7 +187,7 @@ def explain_row(row: pd.Series, rulebook) -> Explanation:
         *(c for j in js for c in (f"box_q{j}_lo", f"box_q{j}_hi")),
         "step_used_deg", "goal_sampled", *(f"sample_q{j}_deg" for j in js),
         "nearest_node", *(f"new_q{j}_deg" for j in js), "outcome", "new_node", "tree_size",
-        "on_path")
+        "on_path", "tree", "connect_nodes")
         if k in row}
     return Explanation(iteration=int(row["iteration"]), rulebook=rulebook.name,
                        bounds_mode=rulebook.bounds_mode, inputs=x, clamped_inputs=clamped,
@@ -229,6 +229,11 @@ def header_lines(e: Explanation) -> list[str]:
     """The first lines of every rendering: iteration, rulebook, what the inputs measure."""
     if e.bounds_mode:  # the paper's semantics
         kind, where = f"bounds: {e.bounds_mode}", "measured from the end effector of the current node"
+    elif "tree" in e.decision:  # a Fuzzy-RRT-Connect trace: the target stands for the goal
+        grown = "start" if int(e.decision["tree"]) == 0 else "goal"
+        kind = f"goal-frame semantics, Fuzzy-RRT-Connect, {grown} tree grows"
+        where = ("measured at the growing tree's current node, in joint space; 'goal' is the "
+                 "other tree's newest node")
     else:
         kind, where = "goal-frame semantics", "measured at the current node, in joint space"
     return [f"Iteration {e.iteration} \u2014 rulebook {e.rulebook!r} ({kind})", "",
@@ -274,6 +279,9 @@ def render_text(e: Explanation) -> str:
         if "outcome" in d:
             lines.append(f"  outcome: {d['outcome']}; tree size {int(d['tree_size'])}; "
                          f"on final path: {bool(d.get('on_path'))}")
+        if "connect_nodes" in d:
+            lines.append(f"  connect: the other tree added {int(d['connect_nodes'])} node(s) "
+                         f"towards the new configuration")
     lines.append("")
     lines.append(f"max |recomputed - recorded| = {e.max_discrepancy:.3g}")
     return "\n".join(lines) + "\n"

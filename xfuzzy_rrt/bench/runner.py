@@ -111,18 +111,18 @@ def load_rulebooks(planners: list[str], rulebook=None) -> tuple[dict[str, Any], 
     default; ``fuzzy-rrt:NAME``/``fuzzy-rrt:DIR`` its own. Loading validates every rule, so a
     broken rulebook fails here, before any planning.
     """
-    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
-    from xfuzzy_rrt.planners.api import parse_planner
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+    from xfuzzy_rrt.planners.api import RULEBOOK_KINDS, default_rulebook_dir, parse_planner
 
     books: dict[str, Any] = {}
     dirs: dict[str, str] = {}
     for label in planners:
         spec = parse_planner(label, "--planners")
-        if spec.kind != "fuzzy-rrt":
+        if spec.kind not in RULEBOOK_KINDS:
             continue
         source = spec.rulebook_dir if spec.rulebook_dir is not None else rulebook
         if source is None:
-            source = default_rulebook_path()
+            source = default_rulebook_dir(spec.kind)
         if hasattr(source, "arrays"):
             books[label] = source
             dirs[label] = None

@@ -20,15 +20,16 @@ def plan(
     scenario: Path = typer.Argument(..., help="Scenario TOML file."),
     planner: str = typer.Option(
         PlannerName.fuzzy_rrt.value, "--planner",
-        help="Planner: rrt, fuzzy-rrt, fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, or "
+        help="Planner: rrt, fuzzy-rrt, fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, "
+             "fuzzy-rrt-connect[:NAME|:DIR] (two goal-frame trees; default rulebook goal-frame-any, any arm), or "
              "ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
     rulebook: Optional[Path] = typer.Option(
-        None, "--rulebook", help="Rulebook directory (fuzzy-rrt; default: the shipped default)."),
+        None, "--rulebook", help="Rulebook directory (fuzzy-rrt, fuzzy-rrt-connect; default: the planner's shipped default)."),
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Random seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON here (default: stdout)."),
     trace: Optional[Path] = typer.Option(
-        None, "--trace", help="Write the per-iteration trace (.parquet or .csv; fuzzy-rrt)."),
+        None, "--trace", help="Write the per-iteration trace (.parquet or .csv; fuzzy-rrt, fuzzy-rrt-connect)."),
     step_deg: float = typer.Option(10.0, "--step-deg", help="RRT step size in degrees."),
     goal_bias: float = typer.Option(0.05, "--goal-bias", help="RRT goal bias in [0, 1]."),
     clearance: Optional[float] = typer.Option(
@@ -42,7 +43,12 @@ def plan(
     collision-free (one line on stderr says where it penetrates and how deep).
     """
     from xfuzzy_rrt.cli.common import check_output_file, emit_json, load_scenario_warn
-    from xfuzzy_rrt.planners.api import parse_planner, plan_scenario, write_trace_checked
+    from xfuzzy_rrt.planners.api import (
+        RULEBOOK_KINDS,
+        parse_planner,
+        plan_scenario,
+        write_trace_checked,
+    )
     from xfuzzy_rrt.planners.termination import check_max_time
 
     spec = parse_planner(planner, "--planner")
@@ -58,14 +64,15 @@ def plan(
     s = load_scenario_warn(scenario)
     rulebook_dir = None
     rulebook_obj = None
-    if spec.kind == "fuzzy-rrt":
+    if spec.kind in RULEBOOK_KINDS:
         from xfuzzy_rrt.errors import InputError
-        from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook
+        from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+        from xfuzzy_rrt.planners.api import default_rulebook_dir
 
         if spec.rulebook_dir is not None and rulebook is not None:
             raise InputError("--rulebook", f"conflicts with --planner {planner} (which names "
                              "its own rulebook); give only one")
-        rulebook_dir = spec.rulebook_dir or rulebook or default_rulebook_path()
+        rulebook_dir = spec.rulebook_dir or rulebook or default_rulebook_dir(spec.kind)
         rulebook_obj = load_rulebook(rulebook_dir)
     result = plan_scenario(
         s, planner=planner, rulebook=rulebook_obj, seed=seed, max_iter=max_iter,

@@ -156,7 +156,7 @@ def show(
 
     lines = [f"rulebook {rb.name!r}  ({rulebook})", f"  semantics: {rb.semantics.summary}",
              f"  bounds mode: {rb.bounds_mode or '(none: not the paper semantics)'}",
-             f"  dof: {rb.dof} ({len(rb.systems)} FIS: {rb.outputs[0]} \u2026 {rb.outputs[-1]})",
+             f"  dof: {'any' if rb.semantics.dof_free else rb.dof} ({len(rb.systems)} FIS: {rb.outputs[0]} \u2026 {rb.outputs[-1]})",
              f"  sha256: {rb.sha256}"]
     if rb.description:
         lines.append(f"  description: {rb.description}")

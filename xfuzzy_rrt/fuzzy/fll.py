@@ -395,6 +395,16 @@ def _infer_dof(root: Path, sem: "_sem.Semantics", problems: list) -> int:
     return _sem.DEFAULT_DOF  # a wrong range is reported by parse_fll, against the 2-DOF one
 
 
+def _names_input(path: Path, name: str) -> bool:
+    """Whether the FLL file at *path* declares ``InputVariable: name`` (goal-frame and
+    goal-frame-any have the same output files; their input names tell them apart)."""
+    try:
+        text = path.read_text("utf-8", errors="replace")
+    except OSError:
+        return False
+    return re.search(r"InputVariable:\s*" + re.escape(name) + r"\s*$", text, flags=re.M) is not None
+
+
 def import_fll(
     fll_dir: str | os.PathLike[str],
     *,
@@ -418,8 +428,10 @@ def import_fll(
     meta: dict = {}
     # which semantics: the one whose second output's file is present (the first, goal_bias,
     # is shared); the export's description line says it too
-    sem = next((s for s in _sem.SEMANTICS.values() if (root / fll_file_name(s.outputs[1])).is_file()),
-               _sem.PAPER)
+    sem = next((s for s in _sem.SEMANTICS.values() if (root / fll_file_name(s.outputs[1])).is_file()
+                and _names_input(root / fll_file_name(s.outputs[0]), s.inputs[0])),
+               None) or next((s for s in _sem.SEMANTICS.values()
+                              if (root / fll_file_name(s.outputs[1])).is_file()), _sem.PAPER)
     sem = sem.for_dof(_infer_dof(root, sem, problems))
     for output in sem.outputs:
         file = root / fll_file_name(output)

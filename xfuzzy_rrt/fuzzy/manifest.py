@@ -25,7 +25,8 @@ degrees (the paper's reading) or ``"relative"`` offsets from the current nearest
 ``dof`` (an integer 2..7, the arm's joints) is written only when it is not 2, so every 2-DOF
 manifest keeps its bytes and its SHA-256; a missing key means 2. It fixes the FIS files the
 directory must hold (see :mod:`.semantics`: a paper rulebook of ``dof = 5`` has
-``bound_1.fis … bound_10.fis``).
+``bound_1.fis … bound_10.fis``). A DOF-free semantics (``goal-frame-any``) writes ``dof = "any"``
+instead, and requires it: its rulebook plans every arm.
 
 ``provenance`` records what produced the rulebook: at least ``kind`` (e.g. ``"hand-written"``,
 ``"ga"``, ``"imported-fll"``), typically also ``command``, ``seed``, ``fitness``,
@@ -198,7 +199,9 @@ def format_manifest(m: Manifest) -> str:
     ]
     if m.semantics != _sem.PAPER.name:
         lines.append(f"semantics = {_toml_string(m.semantics)}")
-    if m.dof != _sem.DEFAULT_DOF:
+    if _sem.get(m.semantics, m.dof).dof_free:
+        lines.append(f"dof = {_toml_string(_sem.ANY_DOF)}")
+    elif m.dof != _sem.DEFAULT_DOF:
         lines.append(f"dof = {m.dof}")
     if m.bounds_mode is not None:
         lines.append(f"bounds_mode = {_toml_string(m.bounds_mode)}")
@@ -283,6 +286,16 @@ def parse_manifest(data: bytes, file: str) -> tuple[Manifest | None, list[Proble
         problem("semantics", f"semantics must be one of {', '.join(map(repr, _sem.SEMANTICS))}, got {sem_name!r}")
         sem_name = _sem.PAPER.name
     dof = doc.get("dof", _sem.DEFAULT_DOF)
+    if _sem.SEMANTICS[sem_name].dof_free:  # one rulebook for every arm: it says so
+        if dof != _sem.ANY_DOF:
+            problem("dof", f'a {sem_name} rulebook plans any arm: write dof = "{_sem.ANY_DOF}"'
+                    + (f", not {dof!r}" if "dof" in doc else ""))
+        dof = _sem.DEFAULT_DOF
+    elif dof == _sem.ANY_DOF:
+        problem("dof", f'dof = "{_sem.ANY_DOF}" needs a DOF-free semantics '
+                f"({', '.join(n for n, s in _sem.SEMANTICS.items() if s.dof_free)}); "
+                f"a {sem_name} rulebook is for one number of joints")
+        dof = _sem.DEFAULT_DOF
     dof_problem = _sem.dof_problem(dof)
     if dof_problem:
         problem("dof", dof_problem)

@@ -40,6 +40,14 @@ rulebook changes. What depends on ``N``:
   its dimension); only ``joint_dist_to_goal``'s range grows to ``[0, 180*sqrt(2N)]`` degrees,
   the diagonal of a joint space of N joints of 360° each (scaled so that N = 2 gives exactly
   the 360 it always had). For several arms, N is the total number of joints planned together.
+
+``goal-frame-any`` — goal-frame for any arm (manifest ``dof = "any"``; :attr:`Semantics.dof_free`):
+the same four inputs and six outputs, renamed (input names are unique across semantics) and
+with every joint-space length (distance, clearance, ahead, behind, side, step) in *normalised
+degrees*: Euclidean joint-space degrees divided by ``sqrt(N/2)`` (:func:`length_scale`). At
+N = 2 every number is goal-frame's; at other N the ranges still hold (the distance range
+``180*sqrt(2N)`` normalises to 360), so one rulebook plans 2 to 7 joints and several arms.
+Only Fuzzy-RRT-Connect (:mod:`xfuzzy_rrt.planners.connect`) plans with it so far.
 """
 
 from __future__ import annotations
@@ -71,6 +79,9 @@ class Semantics:
     default_peaks: Mapping[str, tuple[float, float, float]]
     summary: str
     dof: int = 2
+    #: One rulebook for every arm: inputs and outputs do not depend on the number of joints
+    #: (manifest ``dof = "any"``; the object is the same at every DOF and says ``dof = 2``).
+    dof_free: bool = False
 
     @property
     def n_outputs(self) -> int:
@@ -133,7 +144,39 @@ GOAL_FRAME = Semantics(
             "goal, step",
 )
 
-SEMANTICS: Mapping[str, Semantics] = _ro({s.name: s for s in (PAPER, GOAL_FRAME)})
+#: Joint-space lengths of ``goal-frame-any`` are Euclidean degrees divided by ``sqrt(N / 2)``
+#: for ``N`` joints in all ("normalised degrees"): the length a move of the same per-joint size
+#: has with two joints. So at ``N = 2`` every number is goal-frame's, and the ranges (distance
+#: ``[0, 360]``: the joint-space diagonal ``180*sqrt(2N)`` normalised) hold at every DOF.
+NORM_UNIT = "ndeg"
+
+GOAL_FRAME_ANY = Semantics(
+    name="goal-frame-any",
+    inputs=("norm_dist_to_goal", "stall", "norm_clearance", "reject_share"),
+    outputs=GOAL_FRAME.outputs,
+    input_ranges=_ro({"norm_dist_to_goal": (0.0, 360.0), "stall": (0.0, 200.0),
+                      "norm_clearance": (0.0, 30.0), "reject_share": (0.0, 1.0)}),
+    output_ranges=GOAL_FRAME.output_ranges,
+    units=_ro({"norm_dist_to_goal": NORM_UNIT, "stall": "iterations",
+               "norm_clearance": NORM_UNIT, "reject_share": "", "goal_bias": "",
+               "uniform_share": "", "ahead_deg": NORM_UNIT, "behind_deg": NORM_UNIT,
+               "side_deg": NORM_UNIT, "step_deg": NORM_UNIT}),
+    default_terms=_ro({
+        "norm_dist_to_goal": ("very_near", "near", "medium", "far", "very_far"),
+        "stall": ("none", "brief", "some", "long", "stuck"),
+        "norm_clearance": ("touching", "tight", "narrow", "open", "wide"),
+        "reject_share": ("none", "low", "half", "high", "blocked"),
+    }),
+    default_peaks=_ro({"norm_dist_to_goal": (30.0, 90.0, 180.0), "stall": (10.0, 30.0, 80.0),
+                       "norm_clearance": (2.0, 6.0, 15.0),
+                       "reject_share": (0.25, 0.5, 0.75)}),
+    summary="goal-frame for any arm: goal-frame's inputs and outputs with every joint-space "
+            "length in normalised degrees (Euclidean degrees / sqrt(N/2), N joints in all), so "
+            "one rulebook plans 2 to 7 joints and several arms",
+    dof_free=True,
+)
+
+SEMANTICS: Mapping[str, Semantics] = _ro({s.name: s for s in (PAPER, GOAL_FRAME, GOAL_FRAME_ANY)})
 DEFAULT = PAPER
 
 #: Every input name of every semantics and its range (input names are unique across semantics,
@@ -145,6 +188,14 @@ ALL_INPUT_RANGES: Mapping[str, tuple[float, float]] = _ro(
 MIN_DOF = 2
 MAX_DOF = 7
 DEFAULT_DOF = 2
+#: The manifest's ``dof`` of a DOF-free semantics.
+ANY_DOF = "any"
+
+
+def length_scale(sem: Semantics, dof: int) -> float:
+    """Euclidean joint-space degrees per unit of *sem*'s lengths at *dof* joints in all:
+    ``sqrt(dof / 2)`` for a DOF-free semantics, exactly 1 otherwise (and at 2 joints)."""
+    return math.sqrt(dof / 2.0) if sem.dof_free else 1.0
 
 
 def dof_problem(dof) -> str | None:
@@ -194,9 +245,12 @@ def _goal_frame_at(dof: int) -> Semantics:
     )
 
 
-_BUILDERS = {PAPER.name: _paper_at, GOAL_FRAME.name: _goal_frame_at}
-#: (name, dof) -> Semantics; 2-DOF entries are the module constants themselves.
-_CACHE: dict[tuple[str, int], Semantics] = {(s.name, DEFAULT_DOF): s for s in (PAPER, GOAL_FRAME)}
+_BUILDERS = {PAPER.name: _paper_at, GOAL_FRAME.name: _goal_frame_at,
+             GOAL_FRAME_ANY.name: lambda dof: GOAL_FRAME_ANY}
+#: (name, dof) -> Semantics; 2-DOF entries are the module constants themselves (a DOF-free
+#: semantics is its constant at every DOF).
+_CACHE: dict[tuple[str, int], Semantics] = {(s.name, DEFAULT_DOF): s
+                                            for s in (PAPER, GOAL_FRAME, GOAL_FRAME_ANY)}
 
 
 def get(name: str | None, dof: int = DEFAULT_DOF) -> Semantics:

@@ -123,6 +123,9 @@ _UNITS_NOTE = {
               "# (0 and 2*pi are both east); distances are in metres."],
     "goal-frame": ["# clamped to it. Goal-frame semantics: joint_dist_to_goal and clearance_deg are in",
                    "# joint-space degrees, stagnation in iterations, reject_rate a share (0..1)."],
+    "goal-frame-any": ["# clamped to it. Goal-frame-any semantics (any arm): norm_dist_to_goal, norm_clearance",
+                       "# and the box and step outputs are in normalised degrees (joint-space degrees divided",
+                       "# by sqrt(N/2), N joints in all), stall in iterations, reject_share a share (0..1)."],
 }
 
 

@@ -9,7 +9,7 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
 
-PLANNERS = ("rrt", "fuzzy-rrt")
+PLANNERS = ("rrt", "fuzzy-rrt", "fuzzy-rrt-connect")
 TRACE_SUFFIXES = (".parquet", ".csv")
 #: ``ompl:NAME`` runs OMPL's geometric planner NAME (optional extra; see planners/ompl_bridge.py).
 OMPL_PREFIX = "ompl:"
@@ -18,6 +18,10 @@ FUZZY_PREFIX = "fuzzy-rrt:"
 #: RRT with the step and goal bias of the shipped tuned file (planners/tuned.py); ``rrt``
 #: keeps the paper's 10° and 0.05.
 RRT_TUNED = "rrt:tuned"
+#: ``fuzzy-rrt-connect:NAME|DIR``: Fuzzy-RRT-Connect with that goal-frame(-any) rulebook.
+CONNECT_PREFIX = "fuzzy-rrt-connect:"
+#: Planner kinds that take a rulebook (and can record traces).
+RULEBOOK_KINDS = ("fuzzy-rrt", "fuzzy-rrt-connect")
 
 
 @dataclass(frozen=True)
@@ -25,9 +29,10 @@ class PlannerSpec:
     """One planner as the user wrote it.
 
     ``label`` is the text itself (``"fuzzy-rrt:paper"``): it names the planner in every table
-    so that several rulebooks can stand side by side. ``kind`` is ``rrt``, ``fuzzy-rrt`` or
-    ``ompl``; ``rulebook_dir`` is the directory a ``fuzzy-rrt:...`` label names (``None`` for
-    plain ``fuzzy-rrt``: the caller's rulebook or the shipped default).
+    so that several rulebooks can stand side by side. ``kind`` is ``rrt``, ``fuzzy-rrt``,
+    ``fuzzy-rrt-connect`` or ``ompl``; ``rulebook_dir`` is the directory a ``fuzzy-rrt:...``
+    or ``fuzzy-rrt-connect:...`` label names (``None`` for the plain names: the caller's
+    rulebook or the planner's shipped default).
     """
 
     label: str
@@ -38,8 +43,21 @@ class PlannerSpec:
 def is_known_planner(name: str) -> bool:
     """A built-in planner name, ``fuzzy-rrt:...`` or ``ompl:NAME`` (the part after the colon
     is checked by :func:`parse_planner`). Cheap and import-free, for argument parsing."""
-    return name in PLANNERS or name == RRT_TUNED or any(name.startswith(p) and len(name) > len(p)
-                                   for p in (OMPL_PREFIX, FUZZY_PREFIX))
+    return name in PLANNERS or name == RRT_TUNED or any(
+        name.startswith(p) and len(name) > len(p)
+        for p in (OMPL_PREFIX, FUZZY_PREFIX, CONNECT_PREFIX))
+
+
+def default_rulebook_dir(kind: str) -> Path:
+    """The shipped rulebook a planner kind uses without one: the default rulebook for
+    ``fuzzy-rrt``, the DOF-free ``goal-frame-any`` for ``fuzzy-rrt-connect`` (any arm)."""
+    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, rulebooks_dir
+
+    if kind == "fuzzy-rrt-connect":
+        from xfuzzy_rrt.planners.connect import DEFAULT_RULEBOOK
+
+        return rulebooks_dir() / DEFAULT_RULEBOOK
+    return default_rulebook_path()
 
 
 def shipped_rulebook_names() -> list[str]:
@@ -48,7 +66,7 @@ def shipped_rulebook_names() -> list[str]:
     return [p.name for p in list_rulebooks()]
 
 
-def rulebook_dir_of(arg: str, where: str) -> Path:
+def rulebook_dir_of(arg: str, where: str, prefix: str = FUZZY_PREFIX) -> Path:
     """The directory ``fuzzy-rrt:ARG`` names.
 
     A bare word is a shipped rulebook (``general``, ``paper``, ...); anything with a path
@@ -66,9 +84,9 @@ def rulebook_dir_of(arg: str, where: str) -> Path:
     path = rulebooks_dir() / arg
     if not path.is_dir():
         names = shipped_rulebook_names()
-        raise InputError(where, f"unknown rulebook {arg!r} in {FUZZY_PREFIX}{arg} (shipped: "
+        raise InputError(where, f"unknown rulebook {arg!r} in {prefix}{arg} (shipped: "
                          f"{', '.join(names) or 'none'}; a directory needs a '/', e.g. "
-                         f"{FUZZY_PREFIX}./{arg})")
+                         f"{prefix}./{arg})")
     return path
 
 
@@ -86,13 +104,17 @@ def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
         return PlannerSpec(name, "rrt")
     if name.startswith(FUZZY_PREFIX) and len(name) > len(FUZZY_PREFIX):
         return PlannerSpec(name, "fuzzy-rrt", rulebook_dir_of(name[len(FUZZY_PREFIX):], where))
+    if name.startswith(CONNECT_PREFIX) and len(name) > len(CONNECT_PREFIX):
+        return PlannerSpec(name, "fuzzy-rrt-connect",
+                           rulebook_dir_of(name[len(CONNECT_PREFIX):], where, CONNECT_PREFIX))
     if name.startswith(OMPL_PREFIX) and len(name) > len(OMPL_PREFIX):
         from xfuzzy_rrt.planners.ompl_bridge import check_ompl_planner
 
         check_ompl_planner(name, where)
         return PlannerSpec(name, "ompl")
     raise InputError(where, f"unknown planner {name!r} (expected one of "
-                     f"{', '.join(PLANNERS)}, {RRT_TUNED}, {FUZZY_PREFIX}RULEBOOK or "
+                     f"{', '.join(PLANNERS)}, {RRT_TUNED}, {FUZZY_PREFIX}RULEBOOK, "
+                     f"{CONNECT_PREFIX}RULEBOOK or "
                      f"{OMPL_PREFIX}NAME)")
 
 
@@ -107,13 +129,14 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
                   max_time_s: float | None = None) -> PlanResult:
     """Plan ``scenario`` with the named planner (a label :func:`parse_planner` accepts).
 
-    ``rulebook`` (fuzzy-rrt only) is a loaded rulebook, a directory path, or ``None`` for the
-    shipped default, or for the one a ``fuzzy-rrt:NAME`` label names. ``step_deg``/``goal_bias``
-    configure plain RRT; ``goal_bias`` also the OMPL planners that have one. Fuzzy-RRT takes both
-    from its rulebook. ``ompl:NAME[:sampled][:range=DEG]`` runs OMPL's geometric planner NAME
-    with our collision checker and, unless ``:sampled``, our certified edge check; its range is
-    the label's, else the tuned one (:func:`xfuzzy_rrt.planners.ompl_bridge.plan_ompl`; needs
-    the optional 'ompl' extra). The result's ``planner`` is the label. ``clearance_m``: the
+    ``rulebook`` (fuzzy-rrt and fuzzy-rrt-connect) is a loaded rulebook, a directory path, or
+    ``None`` for the planner's shipped default, or for the one a ``...:NAME`` label names.
+    ``step_deg``/``goal_bias`` configure plain RRT; ``goal_bias`` also the OMPL planners that
+    have one. Fuzzy-RRT takes both from its rulebook. ``ompl:NAME[:sampled][:range=DEG]`` runs
+    OMPL's geometric planner NAME with our collision checker and, unless ``:sampled``, our
+    certified edge check; its range is the label's, else the tuned one
+    (:func:`xfuzzy_rrt.planners.ompl_bridge.plan_ompl`; needs the optional 'ompl' extra). The
+    result's ``planner`` is the label. ``clearance_m``: the
     certified clearance in metres (default: the scenario's ``clearance_m``, else 0).
     ``max_time_s``: a wall-clock budget on top of ``max_iter`` (whichever ends first;
     :mod:`xfuzzy_rrt.planners.termination`).
@@ -122,8 +145,9 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
 
     check_seed(seed)
     spec = parse_planner(planner, "--planner")
-    if spec.kind != "fuzzy-rrt" and trace:
-        raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt")
+    if spec.kind not in RULEBOOK_KINDS and trace:
+        raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt "
+                         "or fuzzy-rrt-connect")
     if spec.kind == "rrt":
         from xfuzzy_rrt.planners.rrt import plan_rrt
 
@@ -131,20 +155,22 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
             tuned = _tuned_rrt("--planner")
             result = plan_rrt(scenario, seed=seed, max_iter=max_iter, clearance_m=clearance_m,
                               max_time_s=max_time_s, **tuned)
-            return dataclasses.replace(result, planner=RRT_TUNED,
-                                       params={**result.params, "tuned": True})
+            return replace_result(result, planner=RRT_TUNED,
+                                  params={**result.params, "tuned": True})
         return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
                         goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
-    if spec.kind == "fuzzy-rrt":
-        from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
-
+    if spec.kind in RULEBOOK_KINDS:
         if spec.rulebook_dir is not None:
             if rulebook is not None and not _same_rulebook(rulebook, spec.rulebook_dir):
                 raise InputError("--rulebook", f"conflicts with --planner {spec.label} (which "
                                  "names its own rulebook); give only one")
             rulebook = rulebook if rulebook is not None else spec.rulebook_dir
-        result = plan_fuzzy_rrt(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
-                                trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
+        if spec.kind == "fuzzy-rrt-connect":
+            from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect as plan_fuzzy
+        else:
+            from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt as plan_fuzzy
+        result = plan_fuzzy(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
+                            trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
         return replace_result(result, planner=spec.label)
     from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 
@@ -195,7 +221,7 @@ def write_trace(result: PlanResult, path: Path, rulebook_dir: str | Path | None 
     if rulebook_dir is not None:
         from xfuzzy_rrt.planners.trace import with_rulebook_dir
 
-        result = dataclasses.replace(result, trace=with_rulebook_dir(result.trace, rulebook_dir))
+        result = replace_result(result, trace=with_rulebook_dir(result.trace, rulebook_dir))
     with atomic_path(path) as tmp:
         if Path(path).suffix.lower() == ".parquet":
             result.trace.to_parquet(tmp, index=False)

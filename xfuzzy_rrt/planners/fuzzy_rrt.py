@@ -105,6 +105,10 @@ def check_rulebook_fits(rb, scenario: Scenario) -> None:
     """
     dof = int(getattr(rb, "dof", 2))
     where = scenario.source or scenario.name
+    if rb.semantics.dof_free:
+        raise InputError(where, f"rulebook {rb.name!r} has the {rb.semantics.name} semantics, "
+                         "which plans with --planner fuzzy-rrt-connect (fuzzy-rrt takes paper "
+                         "and goal-frame rulebooks)")
     if kernel_mode(rb) == GOAL_FRAME:
         if dof != scenario.dof:
             raise InputError(where, f"rulebook {rb.name!r} is a {dof}-DOF goal-frame rulebook; "

@@ -99,6 +99,74 @@ def _joint_dist(a, b):
     return d
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e):
+    """Step 3 of the module docstring: draw the sample of one goal-frame iteration.
+
+    ``q`` is the current node, ``goal`` the configuration the box points at (the goal here;
+    the other tree's newest node in :mod:`xfuzzy_rrt.planners.connect`), ``d_goal`` their
+    distance and ``y`` the six outputs. Writes ``sample``, the traced bounding ``box`` and the
+    direction ``e``; returns whether ``goal`` itself was sampled. Shared so that both planners
+    draw the same random numbers in the same order for the same outputs.
+    """
+    dof = q.shape[0]
+    goal_sampled = uniform(state) < y[0]
+    if goal_sampled:
+        for j in range(dof):
+            sample[j] = goal[j]
+            box[2 * j] = goal[j]
+            box[2 * j + 1] = goal[j]
+    elif uniform(state) < y[1]:
+        for j in range(dof):
+            sample[j] = limits[j, 0] + uniform(state) * (limits[j, 1] - limits[j, 0])
+            box[2 * j] = limits[j, 0]
+            box[2 * j + 1] = limits[j, 1]
+    else:
+        if d_goal > 0.0:
+            for j in range(dof):
+                e[j] = (goal[j] - q[j]) / d_goal
+        else:
+            for j in range(dof):
+                e[j] = 0.0
+            e[0] = 1.0
+        ahead = y[2]
+        behind = y[3]
+        side = y[4]
+        a = -behind + uniform(state) * (ahead + behind)
+        if dof == 2:
+            ex = e[0]
+            ey = e[1]
+            b = (2.0 * uniform(state) - 1.0) * side
+            sample[0] = _clamp(q[0] + a * ex - b * ey, limits[0, 0], limits[0, 1])
+            sample[1] = _clamp(q[1] + a * ey + b * ex, limits[1, 0], limits[1, 1])
+            # bounding box of the rotated box (for traces and drawings), clipped
+            hx = abs(ex) * 0.5 * (ahead + behind) + abs(ey) * side
+            hy = abs(ey) * 0.5 * (ahead + behind) + abs(ex) * side
+            cx = q[0] + ex * 0.5 * (ahead - behind)
+            cy = q[1] + ey * 0.5 * (ahead - behind)
+            box[0] = _clamp(cx - hx, limits[0, 0], limits[0, 1])
+            box[1] = _clamp(cx + hx, limits[0, 0], limits[0, 1])
+            box[2] = _clamp(cy - hy, limits[1, 0], limits[1, 1])
+            box[3] = _clamp(cy + hy, limits[1, 0], limits[1, 1])
+        else:
+            # across: a cube of half-width ``side`` with its part along e removed
+            proj = 0.0
+            for j in range(dof):
+                sample[j] = (2.0 * uniform(state) - 1.0) * side
+                proj += sample[j] * e[j]
+            e_l1 = 0.0
+            for j in range(dof):
+                e_l1 += abs(e[j])
+            for j in range(dof):
+                sample[j] = _clamp(q[j] + a * e[j] + sample[j] - proj * e[j],
+                                   limits[j, 0], limits[j, 1])
+                h = abs(e[j]) * 0.5 * (ahead + behind) + side * (1.0 + abs(e[j]) * e_l1)
+                c0 = q[j] + e[j] * 0.5 * (ahead - behind)
+                box[2 * j] = _clamp(c0 - h, limits[j, 0], limits[j, 1])
+                box[2 * j + 1] = _clamp(c0 + h, limits[j, 0], limits[j, 1])
+    return goal_sampled
+
+
 @nb.njit(cache=True, nogil=True)
 def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step, stop,
                       record, TR):
@@ -153,60 +221,7 @@ def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step
         else:
             infer(knots, consts, x, y, dummy_rule, dummy_w, False)
         step = max(y[5], min_step)
-        goal_sampled = uniform(state) < y[0]
-        if goal_sampled:
-            for j in range(dof):
-                sample[j] = goal[j]
-                box[2 * j] = goal[j]
-                box[2 * j + 1] = goal[j]
-        elif uniform(state) < y[1]:
-            for j in range(dof):
-                sample[j] = limits[j, 0] + uniform(state) * (limits[j, 1] - limits[j, 0])
-                box[2 * j] = limits[j, 0]
-                box[2 * j + 1] = limits[j, 1]
-        else:
-            if d_goal > 0.0:
-                for j in range(dof):
-                    e[j] = (goal[j] - q[j]) / d_goal
-            else:
-                for j in range(dof):
-                    e[j] = 0.0
-                e[0] = 1.0
-            ahead = y[2]
-            behind = y[3]
-            side = y[4]
-            a = -behind + uniform(state) * (ahead + behind)
-            if dof == 2:
-                ex = e[0]
-                ey = e[1]
-                b = (2.0 * uniform(state) - 1.0) * side
-                sample[0] = _clamp(q[0] + a * ex - b * ey, limits[0, 0], limits[0, 1])
-                sample[1] = _clamp(q[1] + a * ey + b * ex, limits[1, 0], limits[1, 1])
-                # bounding box of the rotated box (for traces and drawings), clipped
-                hx = abs(ex) * 0.5 * (ahead + behind) + abs(ey) * side
-                hy = abs(ey) * 0.5 * (ahead + behind) + abs(ex) * side
-                cx = q[0] + ex * 0.5 * (ahead - behind)
-                cy = q[1] + ey * 0.5 * (ahead - behind)
-                box[0] = _clamp(cx - hx, limits[0, 0], limits[0, 1])
-                box[1] = _clamp(cx + hx, limits[0, 0], limits[0, 1])
-                box[2] = _clamp(cy - hy, limits[1, 0], limits[1, 1])
-                box[3] = _clamp(cy + hy, limits[1, 0], limits[1, 1])
-            else:
-                # across: a cube of half-width ``side`` with its part along e removed
-                proj = 0.0
-                for j in range(dof):
-                    sample[j] = (2.0 * uniform(state) - 1.0) * side
-                    proj += sample[j] * e[j]
-                e_l1 = 0.0
-                for j in range(dof):
-                    e_l1 += abs(e[j])
-                for j in range(dof):
-                    sample[j] = _clamp(q[j] + a * e[j] + sample[j] - proj * e[j],
-                                       limits[j, 0], limits[j, 1])
-                    h = abs(e[j]) * 0.5 * (ahead + behind) + side * (1.0 + abs(e[j]) * e_l1)
-                    c0 = q[j] + e[j] * 0.5 * (ahead - behind)
-                    box[2 * j] = _clamp(c0 - h, limits[j, 0], limits[j, 1])
-                    box[2 * j + 1] = _clamp(c0 + h, limits[j, 0], limits[j, 1])
+        goal_sampled = sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e)
         from_node = current
         current = nearest(T, sample)
         outcome, new_index = extend(P, T, current, sample, step, q_near, q_new)

@@ -95,8 +95,9 @@ def _replay_result(path: Path, rulebook: Path | None):
         data = json.loads(path.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise InputError(str(path), f"not a JSON plan result: {exc}") from None
-    if not isinstance(data, dict) or data.get("planner") != "fuzzy-rrt":
-        raise InputError(str(path), "planner: only fuzzy-rrt results can be explained")
+    if not isinstance(data, dict) or data.get("planner") not in ("fuzzy-rrt", "fuzzy-rrt-connect"):
+        raise InputError(str(path), "planner: only fuzzy-rrt and fuzzy-rrt-connect results can "
+                         "be explained")
     for key in ("scenario_file", "rulebook_dir", "rulebook_sha256", "seed"):
         if key not in data:
             raise InputError(str(path), f"{key}: missing; re-run 'xfuzzy-rrt plan' to get a result "
@@ -120,7 +121,10 @@ def _replay_result(path: Path, rulebook: Path | None):
                              f"{sha[:12]}… recorded); pass the rulebook that made it with "
                              "--rulebook DIR")
     max_iter = int(data.get("params", {}).get("max_iter", 10_000))
-    result = plan_fuzzy_rrt(scenario, rb, seed=int(data["seed"]), max_iter=max_iter, trace=True)
+    plan = plan_fuzzy_rrt
+    if data["planner"] == "fuzzy-rrt-connect":
+        from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect as plan
+    result = plan(scenario, rb, seed=int(data["seed"]), max_iter=max_iter, trace=True)
     if result.iterations != data.get("iterations"):
         raise InputError(str(path), "iterations: the replay does not reproduce this result")
     return result.trace, rb

@@ -1,0 +1,246 @@
+"""Fuzzy-RRT-Connect (issue 25): two goal-frame trees that grow towards each other.
+
+Its successful paths are proven collision-free by the independent oracle
+(tests/exact_geometry.py) at 2 joints and at every DOF and arm count a goal-frame rulebook is
+shipped for; it is deterministic per seed; its traces explain with the numbers the planner
+recorded; a rulebook it cannot use, or of the wrong DOF, is refused in one line.
+"""
+
+from __future__ import annotations
+
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import FIXTURES, console_script
+from exact_geometry import oracle_path_problems
+from test_ndof_paths_oracle import dual_arm, single_arm
+from xfuzzy_rrt.analysis.explain import explain_row, trace_row
+from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
+from xfuzzy_rrt.geometry.scenario import load_scenario
+from xfuzzy_rrt.planners.api import parse_planner, plan_scenario
+from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect
+
+TWO_JOINTS = [FIXTURES / "scenarios" / "two-circles.toml",
+              FIXTURES / "scenarios" / "boxes-and-circle.toml"]
+
+
+def _shipped(name: str) -> bool:
+    return (rulebooks_dir() / name / "rulebook.toml").is_file()
+
+
+def _oracle_ok(s, r):
+    assert r.success, (s.name, r.seed, r.violation)
+    assert np.array_equal(r.path_deg[0], np.asarray(s.start_deg, dtype=float))
+    assert np.array_equal(r.path_deg[-1], np.asarray(s.goal_deg, dtype=float))
+    assert oracle_path_problems(s, r.path_deg, s.start_deg, s.goal_deg) == []
+
+
+@pytest.mark.parametrize("path", TWO_JOINTS, ids=lambda p: p.stem)
+def test_two_joint_connect_paths_pass_the_oracle_with_the_goal_frame_rulebook(path):
+    s = load_scenario(path)
+    for seed in range(3):
+        r = plan_scenario(s, "fuzzy-rrt-connect:goal-frame", seed=seed, max_iter=20_000)
+        assert r.planner == "fuzzy-rrt-connect:goal-frame" and r.rulebook == "goal-frame"
+        _oracle_ok(s, r)
+
+
+@pytest.mark.parametrize("path", TWO_JOINTS, ids=lambda p: p.stem)
+def test_at_two_joints_the_dof_free_default_decides_exactly_as_goal_frame(path):
+    s = load_scenario(path)
+    for seed in range(3):
+        a = plan_scenario(s, "fuzzy-rrt-connect", seed=seed)
+        b = plan_scenario(s, "fuzzy-rrt-connect:goal-frame", seed=seed)
+        assert a.rulebook == "goal-frame-any" and a.params["length_scale"] == 1.0
+        assert a.path_deg.tobytes() == b.path_deg.tobytes()
+        assert a.tree_nodes_deg.tobytes() == b.tree_nodes_deg.tobytes()
+        _oracle_ok(s, a)
+
+
+ANY_ARM = [single_arm(3, 0), single_arm(4, 0), single_arm(6, 0), single_arm(7, 0),
+           single_arm(7, 1), dual_arm(2, 0), dual_arm(3, 0), dual_arm(3, 1)]
+
+
+@pytest.mark.parametrize("s", ANY_ARM, ids=lambda s: s.name)
+def test_the_default_plans_any_arm_without_a_rulebook_and_the_oracle_agrees(s):
+    for seed in range(2):
+        r = plan_scenario(s, "fuzzy-rrt-connect", seed=seed, max_iter=20_000)
+        assert r.rulebook == "goal-frame-any"
+        assert r.params["length_scale"] == pytest.approx((s.dof / 2) ** 0.5)
+        _oracle_ok(s, r)
+
+
+@pytest.mark.parametrize("path", sorted((FIXTURES / "many-arms").glob("*.toml")),
+                         ids=lambda p: p.stem)
+def test_the_default_plans_three_and_four_arms(path):
+    # written by ``xfuzzy-rrt scenarios generate --seed 9500 --arms 3`` (and ``--arms 4``)
+    s = load_scenario(path)
+    assert len(s.arms) in (3, 4)
+    for seed in range(2):
+        r = plan_scenario(s, "fuzzy-rrt-connect", seed=seed, max_iter=20_000)
+        _oracle_ok(s, r)
+
+
+def test_fuzzy_rrt_refuses_a_dof_free_rulebook_in_one_line():
+    s = load_scenario(TWO_JOINTS[0])
+    with pytest.raises(InputError, match="fuzzy-rrt-connect"):
+        plan_scenario(s, "fuzzy-rrt:goal-frame-any")
+
+
+def test_a_dof_free_manifest_must_say_dof_any_and_only_it_may(tmp_path):
+    import shutil
+
+    from xfuzzy_rrt.errors import RulebookError
+
+    src = rulebooks_dir() / "goal-frame-any"
+    assert 'dof = "any"' in (src / "rulebook.toml").read_text()
+    bad = tmp_path / "bad"
+    shutil.copytree(src, bad)
+    m = bad / "rulebook.toml"
+    m.write_text(m.read_text().replace('dof = "any"', "dof = 5"))
+    with pytest.raises(RulebookError, match='write dof = "any"'):
+        load_rulebook(bad)
+    gf = tmp_path / "gf"
+    shutil.copytree(rulebooks_dir() / "goal-frame", gf)
+    m = gf / "rulebook.toml"
+    m.write_text(m.read_text().replace('semantics = "goal-frame"\n',
+                                       'semantics = "goal-frame"\ndof = "any"\n'))
+    with pytest.raises(RulebookError, match="needs a DOF-free semantics"):
+        load_rulebook(gf)
+
+
+CASES = [(single_arm(5, 0), "goal-frame-5dof"), (single_arm(5, 1), "goal-frame-5dof"),
+         (dual_arm(3, 0), "goal-frame-dual3"), (dual_arm(3, 1), "goal-frame-dual3")]
+
+
+@pytest.mark.parametrize("s,book", CASES, ids=lambda c: getattr(c, "name", c))
+def test_ndof_and_two_arm_connect_paths_pass_the_oracle(s, book):
+    if not _shipped(book):
+        pytest.skip(f"no {book} rulebook is shipped")
+    for seed in range(2):
+        r = plan_scenario(s, f"fuzzy-rrt-connect:{book}", seed=seed, max_iter=20_000)
+        _oracle_ok(s, r)
+
+
+def test_same_seed_same_bytes_and_other_seeds_differ():
+    s = load_scenario(TWO_JOINTS[1])
+    a = plan_fuzzy_rrt_connect(s, seed=7)
+    b = plan_fuzzy_rrt_connect(s, seed=7)
+    c = plan_fuzzy_rrt_connect(s, seed=8)
+    assert a.path_deg.tobytes() == b.path_deg.tobytes()
+    assert a.tree_nodes_deg.tobytes() == b.tree_nodes_deg.tobytes()
+    assert (a.iterations, a.nodes, a.params) == (b.iterations, b.nodes, b.params)
+    assert a.path_deg.tobytes() != c.path_deg.tobytes()
+
+
+def test_both_trees_grow_and_the_result_holds_both():
+    s = load_scenario(TWO_JOINTS[0])
+    r = plan_fuzzy_rrt_connect(s, seed=1, trace=True)
+    p = r.params
+    assert p["start_tree_nodes"] + p["goal_tree_nodes"] == r.nodes == len(r.tree_nodes_deg)
+    # the forest has exactly two roots: the start and the goal
+    roots = np.flatnonzero(r.tree_parent < 0)
+    assert roots.tolist() == [0, p["start_tree_nodes"]]
+    assert np.array_equal(r.tree_nodes_deg[roots[1]], s.goal_deg)
+    t = r.trace
+    assert set(t["tree"].unique()) <= {0, 1} and t["tree"].iloc[0] == 0
+    if len(t) > 1:
+        assert (t["tree"].to_numpy()[1::2] == 1).all()  # roles swap every iteration
+    assert t["outcome"].iloc[-1] == "goal_reached"
+    assert (t["outcome"] == "goal_reached").sum() == 1
+    # every node on the path was added by some row or is a root/junction copy
+    assert t["on_path"].any()
+
+
+def test_iterations_count_loop_iterations_not_connect_steps():
+    s = load_scenario(TWO_JOINTS[0])
+    r = plan_fuzzy_rrt_connect(s, seed=3, trace=True)
+    assert len(r.trace) == r.iterations
+    connected = int((r.trace["connect_nodes"] > 0).sum())
+    assert r.params["extensions"] >= r.iterations + connected
+
+
+def test_explain_reproduces_every_recorded_output_of_a_connect_trace(tmp_path):
+    s = load_scenario(TWO_JOINTS[1])
+    r = plan_fuzzy_rrt_connect(s, seed=2, trace=True)
+    rb = load_rulebook(rulebooks_dir() / r.rulebook)
+    for it in sorted({1, 2, r.iterations // 2 + 1, r.iterations}):
+        e = explain_row(trace_row(r.trace, it), rb)
+        assert e.max_discrepancy < 1e-12
+        assert e.decision["tree"] == (it - 1) % 2
+    # the command line explains a written trace too
+    trace = tmp_path / "t.parquet"
+    scen = TWO_JOINTS[1]
+    cli = [console_script()]
+    done = subprocess.run([*cli, "plan", str(scen), "--planner", "fuzzy-rrt-connect",
+                           "--seed", "2", "--trace", str(trace), "--out", str(tmp_path / "r.json")],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    out = subprocess.run([*cli, "explain", str(trace), "--iteration", "2", "--exact"],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert "Fuzzy-RRT-Connect, goal tree grows" in out.stdout
+    assert f"planner recorded {float(r.trace.loc[1, 'step_deg'])!r}" in out.stdout
+    replay = subprocess.run([*cli, "explain", str(tmp_path / "r.json"), "--iteration", "1"],
+                            capture_output=True, text=True)
+    assert replay.returncode == 0, replay.stderr
+
+
+def test_a_paper_semantics_rulebook_is_refused_in_one_line():
+    s = load_scenario(TWO_JOINTS[0])
+    with pytest.raises(InputError, match="needs a goal-frame or goal-frame-any rulebook"):
+        plan_scenario(s, "fuzzy-rrt-connect:paper")
+
+
+def test_a_rulebook_of_the_wrong_dof_is_refused_in_one_line():
+    if not _shipped("goal-frame-5dof"):
+        pytest.skip("no goal-frame-5dof rulebook is shipped")
+    s = load_scenario(TWO_JOINTS[0])
+    with pytest.raises(InputError, match="5-DOF goal-frame rulebook"):
+        plan_scenario(s, "fuzzy-rrt-connect:goal-frame-5dof")
+
+
+def test_an_unknown_rulebook_names_the_connect_label():
+    with pytest.raises(InputError, match="fuzzy-rrt-connect:nosuch"):
+        parse_planner("fuzzy-rrt-connect:nosuch")
+
+
+def test_cli_wrong_rulebook_is_one_line_exit_2(tmp_path):
+    cli = [console_script()]
+    out = tmp_path / "r.json"
+    done = subprocess.run([*cli, "plan", str(TWO_JOINTS[0]), "--planner",
+                           "fuzzy-rrt-connect:paper", "--out", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and "goal-frame" in lines[0]
+    assert not out.exists()
+
+
+def test_a_dof_free_trace_records_the_rulebook_values_and_the_degrees_used():
+    s = single_arm(4, 0)
+    r = plan_fuzzy_rrt_connect(s, seed=1, trace=True, max_iter=20_000)
+    t = r.trace
+    scale = r.params["length_scale"]
+    assert scale == pytest.approx(2 ** 0.5)
+    # outputs as the rulebook gave them (explain recomputes them); the step in joint degrees
+    assert np.allclose(t["step_used_deg"], np.maximum(t["step_deg"] * scale, 0.5))
+    rb = load_rulebook(rulebooks_dir() / "goal-frame-any")
+    for it in sorted({1, 2, r.iterations}):
+        assert explain_row(trace_row(t, it), rb).max_discrepancy < 1e-12
+    # the distance input is the normalised distance from the current node to the target
+    row = t.iloc[0]
+    d = np.linalg.norm(np.asarray(s.goal_deg) - np.asarray(s.start_deg))
+    assert row["norm_dist_to_goal"] == pytest.approx(d / scale)
+
+
+def test_a_dof_free_rulebook_round_trips_through_fll(tmp_path):
+    from xfuzzy_rrt.fuzzy.fll import export_fll, import_fll
+
+    rb = load_rulebook(rulebooks_dir() / "goal-frame-any")
+    export_fll(rb, tmp_path / "fll")
+    back = import_fll(tmp_path / "fll")
+    assert back.semantics is rb.semantics and back.semantics.dof_free
+    assert all((a == b).all() for a, b in zip(back.arrays(), rb.arrays()))

@@ -1,0 +1,410 @@
+"""Fuzzy-RRT-Connect: two goal-frame trees, one from the start and one from the goal, that
+grow towards each other and try to join after every accepted extension (RRT-Connect, Kuffner
+and LaValle, ICRA 2000, with the sampling decided by a goal-frame rulebook).
+
+Each iteration, read top to bottom in :func:`connect_kernel` (trees swap roles every
+iteration: iteration 1 grows the start tree, iteration 2 the goal tree, ...):
+
+1. **Target**: the *other* tree's most recently added node. Why this one and not the other
+   tree's node nearest to the growing tree: (a) after a CONNECT attempt the two newest nodes
+   are the closest pair the last attempt produced -- the place where the trees nearly met, the
+   gap to close; (b) it costs no nearest-neighbour query (queries dominate the time of large
+   trees); (c) it moves every iteration, so a tree stuck behind an obstacle sees its target
+   move along the other tree's frontier instead of staring at one fixed point.
+2. **Inputs** of the goal-frame semantics (:mod:`xfuzzy_rrt.planners.goal_frame`), read
+   relative to the target instead of the goal, at the growing tree's current node ``q`` (the
+   node nearest to that tree's previous sample, its root at first -- the paper's carried
+   ``nearest_node``, one per tree): ``joint_dist_to_goal`` = ``|target - q|``;
+   ``stagnation`` = iterations (of both trees) since the gap between the two trees' newest
+   nodes last shrank; ``clearance_deg`` at ``q``; ``reject_rate`` of the growing tree's own
+   extensions (each tree explores its own region, so each has its own clutter estimate).
+3. **Sample** exactly as goal-frame Fuzzy-RRT
+   (:func:`~xfuzzy_rrt.planners.goal_frame.sample_goal_frame`) with the target in the goal's
+   place: the target with probability ``goal_bias``, else uniformly over the joint limits with
+   probability ``uniform_share``, else in the box laid along the direction from ``q`` to the
+   target.
+4. **Grow**: nearest node of the growing tree, one certified extension of at most
+   ``max(step_deg, min_step)`` (:func:`~xfuzzy_rrt.planners.extend.extend`; for the start
+   tree its goal test joins the goal directly, for the goal tree -- run on the problem with
+   start and goal swapped -- the start).
+5. **Connect** (only when step 4 added a node ``q_new``): the other tree's node nearest to
+   ``q_new`` extends towards it by certified steps of the same size, each from the node the
+   previous step added, until it reaches ``q_new`` exactly (the trees are joined), a step is
+   rejected, or the tree is full. Every edge of either tree is certified by ``edge_free``
+   with ``P.margin`` and every node by ``config_free``; the junction is one configuration held
+   by both trees, so no uncertified edge joins them.
+
+**Rulebooks.** A ``goal-frame`` rulebook (its DOF = the problem's joints in all) or a DOF-free
+``goal-frame-any`` one, the default (the shipped ``goal-frame-any``): its lengths are normalised
+degrees, so the kernel divides the distance and clearance inputs by ``scale = sqrt(N/2)`` (``N``
+joints in all) and multiplies the box and step outputs by it; at 2 joints ``scale`` is exactly
+1 and the run is bit for bit the goal-frame one. The paper's semantics is refused: its box is
+absolute or relative to one node, and cannot point at another tree.
+
+The path is the start tree's path to the junction followed by the goal tree's path from the
+junction, reversed; it begins exactly at the start and ends exactly at the goal.
+
+``iterations`` counts loop iterations (one growth step and its connect attempt each; both trees
+together), so the connect's extra steps are not iterations: ``nodes`` (both trees) may exceed
+``iterations``. ``params["extensions"]`` counts every extension attempted (growth and connect
+steps). Each tree holds at most ``2 * max_iter + 8`` nodes; a connect stops when its tree is
+full and a run whose growing tree is full ends as a failure.
+
+Random draws per iteration: those of goal-frame Fuzzy-RRT's step 3, nothing else, so a seed
+fixes the run byte for byte.
+
+Traces (``trace=True``): one row per iteration with every column of a goal-frame Fuzzy-RRT
+trace (inputs as read relative to the target; node indices into the result's tree, start tree
+first then goal tree; ``tree_size`` is both trees' nodes; ``outcome`` is ``goal_reached`` on the
+row where the trees joined, whether the growth or the connect joined them), plus ``tree`` (0:
+the start tree grew, 1: the goal tree) and ``connect_nodes`` (nodes the connect added to the
+other tree).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numba as nb
+import numpy as np
+
+from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.fuzzy.engine import infer
+from xfuzzy_rrt.fuzzy.semantics import length_scale
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
+from xfuzzy_rrt.geometry.clearance import planning_margin
+from xfuzzy_rrt.geometry.collision import clearance_kernel
+from xfuzzy_rrt.geometry.scenario import Scenario
+from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
+from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.goal_frame import (
+    REJECT_DECAY,
+    _joint_dist,
+    problem_lever,
+    sample_goal_frame,
+)
+from xfuzzy_rrt.planners.params import resolve_params
+from xfuzzy_rrt.planners.result import (
+    ACCEPTED,
+    EDGE_BLOCKED,
+    GOAL_REACHED,
+    NODE_IN_COLLISION,
+    PlanResult,
+    path_cost_deg,
+)
+from xfuzzy_rrt.planners.rng import seed_state
+from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
+from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
+from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
+
+PLANNER = "fuzzy-rrt-connect"
+#: The rulebook used without one: the shipped DOF-free rulebook (any arm; at 2 joints it decides
+#: exactly as the goal-frame rulebook).
+DEFAULT_RULEBOOK = "goal-frame-any"
+START_TREE = 0
+GOAL_TREE = 1
+
+
+def tree_capacity(max_iter: int) -> int:
+    """Nodes each tree can hold (growth adds at most 2 per iteration, connects add more)."""
+    return 2 * int(max_iter) + 8
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _same(a, b):
+    for j in range(a.shape[0]):
+        if a[j] != b[j]:
+            return False
+    return True
+
+
+@nb.njit(cache=True, nogil=True)
+def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
+                   TR, grown, connect_nodes, counts):
+    """Run Fuzzy-RRT-Connect; return ``(success, iterations, junction node in TA, junction
+    node in TB)`` (-1, -1 on failure). The two junction nodes hold the same configuration.
+
+    ``P`` is the problem, ``PR`` the same problem with start and goal swapped (the goal tree's
+    view: its extension joins the start directly when it can); ``TA``/``TB`` the empty start
+    and goal trees. With ``record`` true, row ``it - 1`` of ``TR``, ``grown`` and
+    ``connect_nodes`` describes iteration ``it``. ``counts[0]`` receives the number of
+    extensions attempted. ``stop[0] != 0`` ends the run. ``scale``: Euclidean degrees per
+    unit of the rulebook's lengths (1 for goal-frame, ``sqrt(N/2)`` for goal-frame-any): the
+    distance and clearance inputs are divided by it, the box and step outputs multiplied.
+    """
+    state = np.empty(4, dtype=np.uint64)
+    seed_state(seed, state)
+    n_out = knots.shape[0]
+    dof = P.start.shape[0]
+    x = np.empty(4, dtype=np.float64)
+    y = np.empty(n_out, dtype=np.float64)
+    ys = np.empty(n_out, dtype=np.float64)
+    dummy_rule = np.empty((n_out, MAX_FIRED), dtype=np.int32)
+    dummy_w = np.empty((n_out, MAX_FIRED), dtype=np.float64)
+    box = np.empty(2 * dof, dtype=np.float64)
+    sample = np.empty(dof, dtype=np.float64)
+    e = np.empty(dof, dtype=np.float64)
+    q_near = np.empty(dof, dtype=np.float64)
+    q_new = np.empty(dof, dtype=np.float64)
+    c_near = np.empty(dof, dtype=np.float64)
+    c_new = np.empty(dof, dtype=np.float64)
+    target = np.empty(dof, dtype=np.float64)
+    limits = P.limits
+    deg_per_m = math.degrees(1.0) / problem_lever(P)
+    clear_top = knots[0, 2, 4]
+    has_obstacles = P.obstacles.shape[0] > 0 or P.arm_first.shape[0] > 2
+    cap = TA.nodes.shape[0]
+    extensions = 0
+
+    add_node(TA, P.start, -1)
+    add_node(TB, P.goal, -1)
+    current = np.zeros(2, dtype=np.int64)
+    reject = np.zeros(2, dtype=np.float64)
+    best = _joint_dist(P.start, P.goal)
+    stagnation = 0.0
+    g = START_TREE
+    for it in range(1, max_iter + 1):
+        if stop[0] != 0:
+            counts[0] = extensions
+            return False, it - 1, -1, -1
+        row = it - 1
+        if g == START_TREE:
+            G = TA
+            O = TB
+            PG = P
+            PO = PR
+        else:
+            G = TB
+            O = TA
+            PG = PR
+            PO = P
+        if G.meta[0] + 2 > cap:  # the growing tree is full: give up (documented)
+            counts[0] = extensions
+            return False, it - 1, -1, -1
+        # 1. target: the other tree's newest node
+        newest_o = O.meta[0] - 1
+        for j in range(dof):
+            target[j] = O.nodes[newest_o, j]
+        # 2. inputs at this tree's current node, relative to the target
+        from_node = current[g]
+        q = G.nodes[from_node]
+        d_target = _joint_dist(q, target)
+        if has_obstacles:
+            c = clearance_kernel(P, q)
+            c_in = max(c, 0.0) * deg_per_m / scale
+        else:
+            c_in = clear_top
+        x[0] = d_target / scale
+        x[1] = stagnation
+        x[2] = c_in
+        x[3] = reject[g]
+        if record:
+            infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
+        else:
+            infer(knots, consts, x, y, dummy_rule, dummy_w, False)
+        ys[0] = y[0]
+        ys[1] = y[1]
+        for k in range(2, n_out):  # lengths back to joint-space degrees
+            ys[k] = y[k] * scale
+        step = max(ys[5], min_step)
+        # 3. sample in the box pointing at the target
+        target_sampled = sample_goal_frame(q, target, d_target, ys, limits, state, sample, box, e)
+        # 4. grow
+        near = nearest(G, sample)
+        current[g] = near
+        outcome, k = extend(PG, G, near, sample, step, q_near, q_new)
+        extensions += 1
+        rejected = 1.0 if (outcome == NODE_IN_COLLISION or outcome == EDGE_BLOCKED) else 0.0
+        reject[g] = REJECT_DECAY * reject[g] + (1.0 - REJECT_DECAY) * rejected
+        stagnation += 1.0
+        meet_g = -1
+        meet_o = -1
+        n_o = O.meta[0]
+        if outcome == GOAL_REACHED:  # the growing tree joined the other tree's root
+            meet_g = k
+            meet_o = 0
+        elif outcome == ACCEPTED:
+            # 5. connect the other tree to q_new
+            on = nearest(O, q_new)
+            if _same(O.nodes[on], q_new):
+                meet_g = k
+                meet_o = on
+            else:
+                while O.meta[0] + 2 <= cap:
+                    oc, ko = extend(PO, O, on, q_new, step, c_near, c_new)
+                    extensions += 1
+                    if oc == GOAL_REACHED:  # it joined the growing tree's root
+                        meet_g = 0
+                        meet_o = ko
+                        break
+                    if oc != ACCEPTED:
+                        break
+                    on = ko
+                    if _same(c_new, q_new):
+                        meet_g = k
+                        meet_o = ko
+                        break
+        gap = _joint_dist(G.nodes[G.meta[0] - 1], O.nodes[O.meta[0] - 1])
+        if gap < best:
+            best = gap
+            stagnation = 0.0
+        if record:
+            row_outcome = GOAL_REACHED if meet_g >= 0 else outcome
+            record_iteration(TR, row, from_node, x, y, box, target_sampled, sample, near,
+                             q_new, row_outcome, k, TA.meta[0] + TB.meta[0])
+            grown[row] = g
+            connect_nodes[row] = O.meta[0] - n_o
+        if meet_g >= 0:
+            counts[0] = extensions
+            if g == START_TREE:
+                return True, it, meet_g, meet_o
+            return True, it, meet_o, meet_g
+        g = 1 - g
+    counts[0] = extensions
+    return False, max_iter, -1, -1
+
+
+def _resolve_rulebook(rulebook):
+    """A loaded rulebook as given, else the (cached) directory, else the shipped default."""
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached, rulebooks_dir
+
+    if rulebook is None:
+        rulebook = rulebooks_dir() / DEFAULT_RULEBOOK
+    if hasattr(rulebook, "compiled"):
+        return rulebook
+    return load_rulebook_cached(rulebook)
+
+
+def check_connect_rulebook(rb, scenario: Scenario) -> None:
+    """One clear error unless *rb* is a goal-frame rulebook of the problem's total DOF or a
+    DOF-free goal-frame-any one: the connect kernel points the goal-frame box at the other
+    tree, which the paper's workspace semantics cannot express."""
+    from xfuzzy_rrt.planners.fuzzy_rrt import check_rulebook_fits
+
+    if rb.semantics.name not in ("goal-frame", "goal-frame-any"):
+        raise InputError(scenario.source or scenario.name,
+                         f"rulebook {rb.name!r} has the {rb.semantics.name!r} semantics; "
+                         f"{PLANNER} needs a goal-frame or goal-frame-any rulebook (e.g. "
+                         f"{DEFAULT_RULEBOOK})")
+    if not rb.semantics.dof_free:  # a goal-frame-any rulebook plans every arm
+        check_rulebook_fits(rb, scenario)
+
+
+def merged_tree(nodes_a, parent_a, nodes_b, parent_b):
+    """Both trees as one forest (start tree first; goal-tree parents shifted, its root -1)."""
+    na = nodes_a.shape[0]
+    parent = np.concatenate([parent_a, np.where(parent_b >= 0, parent_b + na, -1)])
+    return np.vstack([nodes_a, nodes_b]), parent.astype(np.int64)
+
+
+def joined_path(TA, TB, last_a: int, last_b: int) -> np.ndarray:
+    """Start-tree path to the junction, then the goal-tree path from it, reversed."""
+    pa = extract_path(TA.nodes, TA.parent, last_a)
+    pb = extract_path(TB.nodes, TB.parent, last_b)
+    if not np.array_equal(pa[-1], pb[-1]):  # the kernel joins trees only at one configuration
+        raise RuntimeError("fuzzy-rrt-connect: the two trees' junction nodes differ")
+    return np.vstack([pa, pb[::-1][1:]])
+
+
+def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
+                           max_iter: int = 10_000, trace: bool = False,
+                           min_step_deg: float | None = None, margin: float | None = None,
+                           clearance_m: float | None = None,
+                           max_time_s: float | None = None) -> PlanResult:
+    """Plan with Fuzzy-RRT-Connect (see the module docstring).
+
+    ``rulebook``: a loaded goal-frame or goal-frame-any rulebook, a rulebook directory, or
+    ``None`` for the shipped ``goal-frame-any`` (any arm); a goal-frame rulebook's DOF must be
+    the problem's total number of joints. Other
+    arguments as for :func:`~xfuzzy_rrt.planners.fuzzy_rrt.plan_fuzzy_rrt`.
+    """
+    check_dof(scenario)
+    margin = planning_margin(scenario, clearance_m, margin)
+    check_max_iter(max_iter)
+    params = resolve_params("fuzzy-rrt", max_iter=max_iter, max_time_s=max_time_s,
+                            min_step_deg=min_step_deg)
+    min_step = float(params["min_step_deg"])
+    rb = _resolve_rulebook(rulebook)
+    check_connect_rulebook(rb, scenario)
+    knots, consts = rb.compiled
+    scale = length_scale(rb.semantics, scenario.dof)
+    a = scenario.arrays()
+    problem = a.problem(margin)
+    reverse = problem._replace(start=problem.goal, goal=problem.start)
+    cap = tree_capacity(max_iter)
+    ta = make_tree(cap, a.limits_deg)
+    tb = make_tree(cap, a.limits_deg)
+    rows = int(max_iter) if trace else 1
+    buffers = make_trace(rows, a.dof, knots.shape[0], 1)
+    grown = np.zeros(rows, dtype=np.int8)
+    connect_nodes = np.zeros(rows, dtype=np.int64)
+    counts = np.zeros(1, dtype=np.int64)
+
+    def run(iters, stop):
+        return connect_kernel(problem, reverse, ta, tb, int(seed), int(iters), knots, consts,
+                              scale, min_step, stop, bool(trace), buffers, grown, connect_nodes, counts)
+
+    if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
+        meta_a, meta_b = ta.meta.copy(), tb.meta.copy()
+        run(0, np.zeros(1, dtype=np.int64))
+        reset_tree(ta, meta_a)
+        reset_tree(tb, meta_b)
+    with StopFlag(max_time_s) as flag:
+        t0 = time.perf_counter()
+        ok, iterations, last_a, last_b = run(max_iter, flag.array)
+        wall = time.perf_counter() - t0
+    ok = bool(ok)
+    na, nb_ = int(ta.meta[0]), int(tb.meta[0])
+    path = joined_path(ta, tb, int(last_a), int(last_b)) if ok else np.zeros((0, a.dof))
+    nodes, parent = merged_tree(ta.nodes[:na], ta.parent[:na], tb.nodes[:nb_], tb.parent[:nb_])
+    from xfuzzy_rrt.planners.result import certified_result  # certifies the path (found -> success)
+
+    recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
+                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale,
+                "extensions": int(counts[0]), "start_tree_nodes": na, "goal_tree_nodes": nb_}
+    if max_time_s is not None:
+        recorded["max_time_s"] = float(params["max_time_s"])
+        recorded["stopped_by"] = stopped_by(ok, int(iterations), int(max_iter), flag)
+    result = certified_result(
+        a, margin, ok, scenario=scenario.name, planner=PLANNER, seed=int(seed),
+        iterations=int(iterations), nodes=na + nb_,
+        cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
+        tree_nodes_deg=nodes, tree_parent=parent, rulebook=rb.name,
+        rulebook_sha256=rb.sha256, params=recorded,
+    )
+    if trace:
+        frame = _trace_frame(buffers, grown, connect_nodes, int(iterations), nodes, parent, na,
+                             int(last_a), int(last_b) + na if ok else -1, rb, min_step, scale)
+        result = dataclasses.replace(result, trace=frame)
+    return result
+
+
+def _trace_frame(buffers, grown, connect_nodes, n, nodes, parent, na, last_a, last_b, rb,
+                 min_step, scale):
+    """The goal-frame trace frame with merged-tree node indices, ``on_path`` over both trees,
+    and the ``tree``/``connect_nodes`` columns appended."""
+    from xfuzzy_rrt.planners.trace import trace_frame
+
+    goal_rows = grown[:n] == GOAL_TREE
+    for arr in (buffers.from_node, buffers.nearest, buffers.node):
+        col = arr[:n]
+        shift = goal_rows & (col >= 0)
+        col[shift] += na
+    frame = trace_frame(buffers, n, nodes, parent, -1, rb, min_step, 1)
+    on_path_nodes = np.zeros(len(parent), dtype=bool)
+    for i in (last_a, last_b):
+        while i >= 0:
+            on_path_nodes[i] = True
+            i = int(parent[i])
+    new_node = frame["new_node"].to_numpy()
+    added = new_node >= 0
+    on_path = np.zeros(n, dtype=bool)
+    on_path[added] = on_path_nodes[new_node[added]]
+    frame["on_path"] = on_path
+    if scale != 1.0:  # the recorded outputs are the rulebook's (normalised) values
+        frame["step_used_deg"] = np.maximum(buffers.y[:n, -1] * scale, min_step)
+    frame["tree"] = grown[:n].astype(np.int64)
+    frame["connect_nodes"] = connect_nodes[:n].copy()
+    return frame

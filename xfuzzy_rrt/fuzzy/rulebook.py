@@ -329,23 +329,24 @@ def _stamp(st: os.stat_result) -> tuple[int, int, int, int]:
     return st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino
 
 
-def _stat_key(root: str, names: tuple[str, ...]) -> tuple:
-    """(size, mtime_ns, ctime_ns, inode) of the directory and of each of its files ``names``.
+def _stat_key(root: str, paths: tuple[str, ...]) -> tuple:
+    """(size, mtime_ns, ctime_ns, inode) of the directory and of each of its files ``paths``.
 
     Why ctime too: a same-size edit whose mtime is put back (``os.utime``, ``touch -r``,
     ``cp -p``) still sets the ctime to *now*, which no user call can forge. The directory's own
     stamps change when a file is added, removed or renamed over (an atomic save), so every file
     of the directory counts without listing it again on every look-up.
     """
-    return (_stamp(os.stat(root)), *(_stamp(os.stat(os.path.join(root, n))) for n in names))
+    stat = os.stat
+    return (_stamp(stat(root)), *[_stamp(stat(p)) for p in paths])
 
 
 #: A file stamped this close to the moment its directory was looked at could be edited again
 #: within the same timestamp tick (coarse kernel clocks; 2 s on FAT): such an entry is
 #: "racy" and is re-hashed on every look-up until its files are older (as git does).
 RACY_WINDOW_NS = 2_000_000_000
-#: ``absolute path -> (file names, stat key, real path, content key, racy)``: the last look-up
-#: of each directory.
+#: ``absolute path -> (its files' paths, stat key, real path, content key, racy)``: the last
+#: look-up of each directory.
 _STAT_CACHE: dict[str, tuple] = {}
 
 
@@ -377,7 +378,7 @@ def load_rulebook_cached(path: str | os.PathLike[str]) -> "Rulebook":
         return load_rulebook(root)  # raises the usual one-line error
     now = time.time_ns()
     try:
-        names = tuple(sorted(os.listdir(root)))
+        names = tuple(os.path.join(key, n) for n in sorted(os.listdir(root)))
         stat_key = _stat_key(key, names)
     except OSError:
         return load_rulebook(root)

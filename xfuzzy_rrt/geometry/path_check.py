@@ -144,6 +144,18 @@ def _min_clearance(problem, path) -> tuple[float, int, float]:
     return value, seg, s
 
 
+def segments_certified(arrays, path_deg, margin: float = CERT_MARGIN_M) -> int | None:
+    """The work (distance evaluations) of certifying every segment of ``path_deg``, or ``None``
+    when a segment or vertex fails: :func:`certify_path`'s verdict without its exact minimum
+    clearance, for callers that measure the clearance only when asked (``planners/result.py``)."""
+    path = np.ascontiguousarray(np.asarray(path_deg, dtype=np.float64))
+    problem = arrays.problem(margin)
+    certified, _bad, first_out = certify_kernel(problem, path, float(margin))
+    if not certified or first_out >= 0:
+        return None
+    return int(problem.work[0])
+
+
 def path_min_clearance(arrays, path_deg, margin: float = CERT_MARGIN_M) -> tuple[float, float]:
     """``(min_clearance_m, penetration_m)`` of a path exactly as :func:`certify_path` reports
     them, without certifying it: what a result computes only when someone asks (the branch and

@@ -63,7 +63,6 @@ other tree).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 
@@ -97,7 +96,17 @@ from xfuzzy_rrt.planners.result import (
 from xfuzzy_rrt.planners.rng import seed_state
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
-from xfuzzy_rrt.planners.tree import add_node, extract_path, make_tree, nearest, reset_tree
+from xfuzzy_rrt.geometry.problem import Problem
+from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
+from xfuzzy_rrt.planners.trace_record import TraceArrays
+from xfuzzy_rrt.planners.tree import (
+    NN_VISITS,
+    TreeArrays,
+    add_node,
+    extract_path,
+    nearest,
+    reset_tree,
+)
 
 PLANNER = "fuzzy-rrt-connect"
 #: The rulebook used without one: the shipped DOF-free rulebook (any arm; at 2 joints it decides
@@ -299,6 +308,16 @@ def merged_tree(nodes_a, parent_a, nodes_b, parent_b):
     return np.vstack([nodes_a, nodes_b]), parent.astype(np.int64)
 
 
+@nb.njit(cache=True, nogil=True)
+def connect_entry(p, pr, ta, tb, seed, max_iter, knots, consts, scale, min_step, stop, record,
+                  tr, grown, connect_nodes, counts):
+    """:func:`connect_kernel` with the problem, tree and trace bundles as *plain* tuples (typed
+    by numba's fast C path; see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`)."""
+    return connect_kernel(Problem(*p), Problem(*pr), TreeArrays(*ta), TreeArrays(*tb), seed,
+                          max_iter, knots, consts, scale, min_step, stop, record,
+                          TraceArrays(*tr), grown, connect_nodes, counts)
+
+
 def joined_path(TA, TB, last_a: int, last_b: int) -> np.ndarray:
     """Start-tree path to the junction, then the goal-tree path from it, reversed."""
     pa = extract_path(TA.nodes, TA.parent, last_a)
@@ -330,27 +349,32 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     check_connect_rulebook(rb, scenario)
     knots, consts = rb.compiled
     scale = length_scale(rb.semantics, scenario.dof)
-    a = scenario.arrays()
+    a = scenario_arrays(scenario)
     problem = a.problem(margin)
-    reverse = problem._replace(start=problem.goal, goal=problem.start)
+    reverse = problem._replace(start=problem.goal, goal=problem.start)  # shares the work counter
     cap = tree_capacity(max_iter)
-    ta = make_tree(cap, a.limits_deg)
-    tb = make_tree(cap, a.limits_deg)
+    ta = empty_tree(cap, a.limits_deg, slot=0)
+    tb = empty_tree(cap, a.limits_deg, slot=1)
     rows = int(max_iter) if trace else 1
-    buffers = make_trace(rows, a.dof, knots.shape[0], 1)
+    buffers = (make_trace(rows, a.dof, knots.shape[0], 1) if trace
+               else idle_trace(a.dof, knots.shape[0], 1))
     grown = np.zeros(rows, dtype=np.int8)
     connect_nodes = np.zeros(rows, dtype=np.int64)
     counts = np.zeros(1, dtype=np.int64)
+    args = (tuple(problem), tuple(reverse), tuple(ta), tuple(tb), int(seed))
+    tail = (knots, consts, scale, min_step)
 
     def run(iters, stop):
-        return connect_kernel(problem, reverse, ta, tb, int(seed), int(iters), knots, consts,
-                              scale, min_step, stop, bool(trace), buffers, grown, connect_nodes, counts)
+        return connect_entry(*args, int(iters), *tail, stop, bool(trace), tuple(buffers), grown,
+                             connect_nodes, counts)
 
     if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
         meta_a, meta_b = ta.meta.copy(), tb.meta.copy()
         run(0, np.zeros(1, dtype=np.int64))
         reset_tree(ta, meta_a)
         reset_tree(tb, meta_b)
+        problem.work[0] = 0
+        counts[0] = 0
     with StopFlag(max_time_s) as flag:
         t0 = time.perf_counter()
         ok, iterations, last_a, last_b = run(max_iter, flag.array)
@@ -359,7 +383,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     na, nb_ = int(ta.meta[0]), int(tb.meta[0])
     path = joined_path(ta, tb, int(last_a), int(last_b)) if ok else np.zeros((0, a.dof))
     nodes, parent = merged_tree(ta.nodes[:na], ta.parent[:na], tb.nodes[:nb_], tb.parent[:nb_])
-    from xfuzzy_rrt.planners.result import certified_result  # certifies the path (found -> success)
+    from xfuzzy_rrt.planners.result import certified_result, replace_result
 
     recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
                 "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale,
@@ -373,11 +397,15 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=nodes, tree_parent=parent, rulebook=rb.name,
         rulebook_sha256=rb.sha256, params=recorded,
+        work=int(problem.work[0] + ta.meta[NN_VISITS] + tb.meta[NN_VISITS]),
+        # every path segment is a tree edge the kernel certified with edge_free at this margin
+        # (the goal tree's, traversed backwards: the same set of configurations)
+        edges_certified=True,
     )
     if trace:
         frame = _trace_frame(buffers, grown, connect_nodes, int(iterations), nodes, parent, na,
                              int(last_a), int(last_b) + na if ok else -1, rb, min_step, scale)
-        result = dataclasses.replace(result, trace=frame)
+        result = replace_result(result, trace=frame)
     return result
 
 

@@ -42,12 +42,12 @@ def scenario_arrays(scenario):
     return arrays
 
 
-def empty_tree(capacity: int, limits_deg: np.ndarray) -> TreeArrays:
+def empty_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeArrays:
     """An empty tree for ``capacity`` nodes in ``limits_deg``, as :func:`make_tree` makes it,
     reused within this thread from one plan to the next (a result keeps copies, never the
-    tree's arrays)."""
+    tree's arrays). ``slot`` tells apart trees one plan uses at once (Fuzzy-RRT-Connect's two)."""
     limits = np.asarray(limits_deg, dtype=np.float64)
-    key = (int(capacity), limits.shape, limits.tobytes())
+    key = (int(capacity), limits.shape, limits.tobytes(), int(slot))
     pool = getattr(_local, "trees", None)
     if pool is None:
         pool = _local.trees = OrderedDict()

@@ -200,7 +200,11 @@ def certified_result(arrays, margin: float, found: bool, edges_certified: bool =
     re-checked: no certification work is done twice. A certified path's exact clearance is
     measured on first access (module docstring).
     """
-    from xfuzzy_rrt.geometry.path_check import certify_path, path_min_clearance
+    from xfuzzy_rrt.geometry.path_check import (
+        certify_path,
+        path_min_clearance,
+        segments_certified,
+    )
 
     path = np.asarray(fields["path_deg"], dtype=np.float64)
     if not found or path.size == 0:
@@ -211,6 +215,19 @@ def certified_result(arrays, margin: float, found: bool, edges_certified: bool =
         if bool(np.all((path >= lim[:, 0]) & (path <= lim[:, 1]))):
             result = PlanResult(found=True, certified=True, min_clearance_m=_PENDING,
                                 penetration_m=_PENDING, violation=None, **fields)
+            result.__dict__["_measurement"] = functools.partial(path_min_clearance, arrays,
+                                                                path, float(margin))
+            return result
+    if path.ndim == 2 and path.shape[0] >= 2 and path.shape[1] == arrays.limits_deg.shape[0] \
+            and np.all(np.isfinite(path)):
+        # Another planner's path (OMPL's): every segment goes through the certified check now;
+        # only when it passes is the exact clearance deferred like ours. A path that fails is
+        # measured at once, because its violation sentence names where and how deep.
+        work = segments_certified(arrays, path, margin)
+        if work is not None:
+            result = PlanResult(found=True, certified=True, min_clearance_m=_PENDING,
+                                penetration_m=_PENDING, violation=None, certify_work=work,
+                                **fields)
             result.__dict__["_measurement"] = functools.partial(path_min_clearance, arrays,
                                                                 path, float(margin))
             return result

@@ -677,8 +677,9 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
         work=params["work"],
     )
     # Kept in params too for readers of older result files; the top-level fields are the truth.
+    # (``penetration_m`` is not copied here: reading it would measure the exact clearance on
+    # every plan, which the result defers until someone asks.)
     params["certified"] = result.certified if exact else None
-    params["penetration_m"] = result.penetration_m if exact else None
     return result
 
 

@@ -19,8 +19,10 @@ from pathlib import Path
 from xfuzzy_rrt.errors import InputError
 
 
+@lru_cache(maxsize=1)
 def tuned_dir() -> Path:
-    """The folder of the shipped tuned-parameter files (package data)."""
+    """The folder of the shipped tuned-parameter files (package data; resolved once: it is
+    looked up on every plan of a tuned planner)."""
     return Path(__file__).resolve().parent.parent / "data" / "tuned"
 
 

@@ -28,6 +28,7 @@
 #            multiplied by F -- and run the test files NAMED AFTER that bound (numba on)
 #            against each. Exit 0 only when every weakening fails its own tests. Try F = 1.05.
 # Env:     PYTHON (default .venv/bin/python), MUTATION_JOBS (default 1), MUTATION_TESTS,
+#          WEAKEN_VARIANTS (with --weaken: which of the variants above, default all),
 #          MUTATION_MUTANTS (mutant name globs, default: the safety core as above).
 # Needs:   mutmut >= 3.8 in that interpreter (.venv/bin/pip install mutmut).
 # Output:  every surviving mutant with its diff, and a last line
@@ -69,7 +70,7 @@ fi
 cd "$WORK"
 if [ -n "$WEAKEN" ]; then
   status=0
-  for variant in bound advance armarm armarm-max selfpair clearance effective radius; do
+  for variant in ${WEAKEN_VARIANTS:-bound advance armarm armarm-max selfpair clearance effective radius}; do
     for f in xfuzzy_rrt/geometry/collision.py xfuzzy_rrt/planners/goal_frame.py; do
       cp "$ROOT/$f" "$f"
     done
@@ -134,7 +135,7 @@ PYEOF
     else
       for f in $named; do
         n=$(grep -cE "^FAILED $f::" weaken-$variant.log || true)
-        echo "  $f: $n failing, e.g. $(grep -E "^FAILED $f::" weaken-$variant.log | head -1 | sed -E 's/^FAILED [^:]*:://; s/ - .*//')"
+        echo "  $f: $n failing, e.g. $(grep -m1 -E "^FAILED $f::" weaken-$variant.log | sed -E 's/^FAILED [^:]*:://; s/ - .*//' || true)"
       done
       echo "caught (log: $WORK/weaken-$variant.log)"
     fi

@@ -178,7 +178,8 @@ def test_a_scenario_whose_start_folds_into_itself_is_refused_with_one_line(tmp_p
     q = ", ".join(f"{v:g}" for v in CURLED)
     f = tmp_path / "curled.toml"
     f.write_text(f'name = "curled"\n[arm]\nlinks = [{", ".join(["0.05"] * 7)}]\n'
-                 f"link_radius = 0.004\n[start]\nq_deg = [{q}]\n[goal]\nq_deg = [0, 0, 0, 0, 0, 0, 0]\n")
+                 f"link_radius = 0.004\n[start]\nq_deg = [{q}]\n"
+                 f"[goal]\nq_deg = [0, 0, 0, 0, 0, 0, 0]\n")
     with pytest.raises(ScenarioError) as err:
         load_scenario(f)
     message = str(err.value)

@@ -74,7 +74,8 @@ def test_every_problem_bundle_starts_a_fresh_counter():
     P2 = a.problem(CERT_MARGIN_M)
     assert P2.work[0] == 0 and P2.work is not P1.work
     assert P2.work.dtype == np.int64 and P2.work.shape == (1,)
-    one = single_arm_problem(np.array([0.2, 0.1]), np.zeros(2), 0.0, OBSTACLES, np.tile([-180.0, 180.0], (2, 1)))
+    one = single_arm_problem(np.array([0.2, 0.1]), np.zeros(2), 0.0, OBSTACLES,
+                             np.tile([-180.0, 180.0], (2, 1)))
     assert one.work[0] == 0 and n_distance_pairs(one) == 4
 
 

@@ -20,6 +20,9 @@ Each file's description records, like the shared samples, the grid-optimal path 
 8-connected path through free cells of a 2° C-space grid: an estimate of the optimum), the
 straight-line length and the fraction of C-space in collision.
 
+``family="trap"`` (:func:`_draw_trap`) keeps only draws whose grid-optimal path is at least
+:data:`TRAP_DETOUR` times the straight distance, and records that ratio in the description.
+
 The problems depend only on ``seed``: draw ``k`` uses ``numpy.random.default_rng([seed, k])``,
 so ``--count 24`` starts with the same problems as ``--count 8``.
 
@@ -171,8 +174,9 @@ def _draw_trap(rng: np.random.Generator, name: str) -> Scenario:
     link 2 reaches into it), in a direction ``a`` within ±120° of joint 1's zero; else a radial
     wall (1-2 cm thick, 10-20 cm long, an axis-aligned box) pointing along -90°, 0° or 90°, its
     inner end likewise 1-6 cm beyond link 1. Joint 1 starts 25-100° on one side of ``a`` and
-    ends 25-100° on the other (clipped to ±170°), joint 2 within ±130° (stretched enough that link 2 sweeps into the obstacle): sweeping straight
-    across hits the obstacle, and the way round (fold under it, unfold beyond) is long. Whether
+    ends 25-100° on the other (clipped to ±170°), joint 2 within ±130° (stretched enough for
+    link 2 to reach the obstacle): sweeping straight across hits it, and the way round (fold
+    under it, unfold beyond) is long. Whether
     a draw really is a trap is decided by :func:`generate_one` (straight segment blocked, grid
     detour ≥ :data:`TRAP_DETOUR`), not assumed here.
     """

@@ -62,5 +62,5 @@ def test_a_passage_narrower_than_the_grid_is_described_not_called_infinite(monke
 def test_unknown_family_is_one_line(run_cli, tmp_path):
     proc = run_cli("scenarios", "generate", "--family", "easy", "--count", "1", "--out", tmp_path / "x")
     assert proc.returncode == 2
-    assert proc.stderr.strip() == "error: --family: must be one of sample, hard, mira, got 'easy'"
+    assert proc.stderr.strip() == "error: --family: must be one of sample, hard, mira, trap, got 'easy'"
     assert not (tmp_path / "x").exists()

@@ -10,7 +10,7 @@ import typer
 
 from xfuzzy_rrt.cli.common import check_seed_option
 
-app = typer.Typer(help="Scenario files: generate problems of the sample-* family, N-DOF arms or several arms.",
+app = typer.Typer(help="Scenario files: generate problems of the sample-* family (or hard, mira, trap), N-DOF arms or several arms.",
                   no_args_is_help=True, add_completion=False, rich_markup_mode=None)
 
 
@@ -20,7 +20,7 @@ def generate(
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, min=0, help="Generator seed: same seed, same files."),
     out: Path = typer.Option(..., "--out", help="Folder to write <name>.toml files into."),
     prefix: Optional[str] = typer.Option(None, "--prefix", help="Name prefix: <prefix>-<seed>-<k> (default: gen for the sample family, else the family's name)."),
-    family: Optional[str] = typer.Option(None, "--family", help="2-DOF single-arm families: sample (the shared sample-* family; the default), hard (cluttered, thin walls, narrow passages) or mira (MIRA-like arm threading a gap between organs)."),
+    family: Optional[str] = typer.Option(None, "--family", help="2-DOF single-arm families: sample (the shared sample-* family; the default), hard (cluttered, thin walls, narrow passages), mira (MIRA-like arm threading a gap between organs) or trap (a large organ or wall across the way: shortest path at least 1.5x the straight one)."),
     dof: int = typer.Option(2, "--dof", help="Joints per arm, 2 to 7 (default 2). Other than 2 selects the N-DOF family (see docs/scenarios.md)."),
     arms: int = typer.Option(1, "--arms", help="Arms sharing the workspace, 1 to 4 (default 1). More than 1 writes [[arms]] files whose arms can touch each other."),
 ) -> int:

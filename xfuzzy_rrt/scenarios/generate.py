@@ -20,6 +20,9 @@ Each file's description records, like the shared samples, the grid-optimal path 
 8-connected path through free cells of a 2° C-space grid: an estimate of the optimum), the
 straight-line length and the fraction of C-space in collision.
 
+``family="trap"`` (:func:`_draw_trap`) keeps only draws whose grid-optimal path is at least
+:data:`TRAP_DETOUR` times the straight distance, and records that ratio in the description.
+
 The problems depend only on ``seed``: draw ``k`` uses ``numpy.random.default_rng([seed, k])``,
 so ``--count 24`` starts with the same problems as ``--count 8``.
 
@@ -64,8 +67,17 @@ class GeneratedProblem:
 
 
 #: Problem families: the shared ``sample-*`` family and two harder ones that cover what users
-#: meet beyond it (training on a mixture is what lets a rulebook transfer; see rulebooks/README).
-FAMILIES = ("sample", "hard", "mira")
+#: meet beyond it (training on a mixture is what lets a rulebook transfer; see rulebooks/README),
+#: and ``trap`` (issue 25), where heading for the goal leads into a dead end. A new family goes
+#: at the end: its index picks its random stream, so the others' files stay byte-identical.
+FAMILIES = ("sample", "hard", "mira", "trap")
+
+#: Least ratio of the grid-optimal path to the straight joint-space distance of a ``trap``
+#: problem. Why 1.5: a detour of half the straight distance again cannot come from grazing one
+#: obstacle's edge (the grid path then stays within a few cells of the straight line); it means
+#: the way towards the goal is blocked and the path must first move *away* from it (fold the
+#: elbow under an organ, go round a wall's end) — where goal-biased growth is wasted (issue 25).
+TRAP_DETOUR = 1.5
 
 
 def _draw(rng: np.random.Generator, name: str, family: str = "sample") -> Scenario:
@@ -73,6 +85,8 @@ def _draw(rng: np.random.Generator, name: str, family: str = "sample") -> Scenar
         return _draw_hard(rng, name)
     if family == "mira":
         return _draw_mira(rng, name)
+    if family == "trap":
+        return _draw_trap(rng, name)
     l1 = round(float(rng.uniform(0.14, 0.20)), 3)
     l2 = round(float(rng.uniform(0.09, 0.15)), 3)
     q = rng.integers(-170, 171, size=4).astype(float)
@@ -148,6 +162,56 @@ def _draw_mira(rng: np.random.Generator, name: str) -> Scenario:
         w, h = rng.uniform(0.02, 0.07, size=2)
         obstacles.append(_box(rb * math.cos(ab), rb * math.sin(ab), w, h))
     return Scenario(name=name, arm=_arm(l1, l2), start_deg=(q[0], q[1]), goal_deg=(q[2], q[3]),
+                    obstacles=tuple(obstacles))
+
+
+def _draw_trap(rng: np.random.Generator, name: str) -> Scenario:
+    """Trap-like: the sample family's arm, one large obstacle straight across the way from start
+    to goal, plus 1-3 small clutter obstacles.
+
+    The large obstacle is, half the time, an organ (circle of 6-10 cm radius) whose near edge is
+    1-6 cm beyond link 1 (so a folded arm fits under it: nearer, the arm could never pass; and
+    link 2 reaches into it), in a direction ``a`` within ±120° of joint 1's zero; else a radial
+    wall (1-2 cm thick, 10-20 cm long, an axis-aligned box) pointing along -90°, 0° or 90°, its
+    inner end likewise 1-6 cm beyond link 1. Joint 1 starts 25-100° on one side of ``a`` and
+    ends 25-100° on the other (clipped to ±170°), joint 2 within ±130° (stretched enough for
+    link 2 to reach the obstacle): sweeping straight across hits it, and the way round (fold
+    under it, unfold beyond) is long. Whether
+    a draw really is a trap is decided by :func:`generate_one` (straight segment blocked, grid
+    detour ≥ :data:`TRAP_DETOUR`), not assumed here.
+    """
+    l1, l2 = rng.uniform(0.14, 0.20), rng.uniform(0.09, 0.15)
+    inner = l1 + rng.uniform(0.01, 0.06)  # the big obstacle's nearest point to the base
+    if rng.random() < 0.5:
+        radius = float(rng.uniform(0.06, 0.10))
+        a = math.radians(rng.uniform(-120.0, 120.0))
+        r = inner + radius
+        big = Circle(center=(round(r * math.cos(a), 4), round(r * math.sin(a), 4)),
+                     radius=round(radius, 4))
+    else:
+        a = math.radians(90.0 * (int(rng.integers(0, 3)) - 1))
+        t, length = rng.uniform(0.01, 0.02), rng.uniform(0.10, 0.20)
+        r = inner + length / 2
+        cx, cy = r * math.cos(a), r * math.sin(a)
+        big = _box(cx, cy, length, t) if abs(math.cos(a)) > 0.5 else _box(cx, cy, t, length)
+    side = 1.0 if rng.random() < 0.5 else -1.0
+    d_start, d_goal = rng.uniform(25.0, 100.0, size=2)
+    a_deg = math.degrees(a)
+    q1 = [float(np.clip(round(a_deg - side * d_start), -170, 170)),
+          float(np.clip(round(a_deg + side * d_goal), -170, 170))]
+    q2 = rng.integers(-130, 131, size=2).astype(float)
+    obstacles = [big]
+    for _ in range(int(rng.integers(1, 4))):
+        rc = rng.uniform(0.12, 0.34)
+        ac = rng.uniform(0.0, 2.0 * math.pi)
+        cx, cy = rc * math.cos(ac), rc * math.sin(ac)
+        if rng.random() < 0.7:
+            obstacles.append(Circle(center=(round(cx, 4), round(cy, 4)),
+                                    radius=round(float(rng.uniform(0.02, 0.04)), 4)))
+        else:
+            w, h = rng.uniform(0.03, 0.06, size=2)
+            obstacles.append(_box(cx, cy, float(w), float(h)))
+    return Scenario(name=name, arm=_arm(l1, l2), start_deg=(q1[0], q2[0]), goal_deg=(q1[1], q2[1]),
                     obstacles=tuple(obstacles))
 
 
@@ -251,12 +315,20 @@ def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample",
             continue  # trivial: the straight segment is free
         if not (_config_ok(a, a.start_deg) and _config_ok(a, a.goal_deg)):
             continue  # free, but closer than ENDPOINT_CLEARANCE_M
+        straight = float(np.linalg.norm(a.goal_deg - a.start_deg))
+        if family == "trap":
+            # the grid (milliseconds) before RRT (up to seconds when it fails): most trap drafts
+            # fall on the detour, and a problem without a grid path has no detour to record
+            grid = c_space_grid(s)
+            optimal = grid_optimal_deg(s, grid=grid)
+            if not (math.isfinite(optimal) and optimal >= TRAP_DETOUR * straight):
+                continue  # no trap: the shortest way is (nearly) straight
         if not plan_rrt(s, seed=0, max_iter=RRT_BUDGET).success:
             continue  # not shown solvable
-        grid = c_space_grid(s)
+        if family != "trap":
+            grid = c_space_grid(s)
+            optimal = grid_optimal_deg(s, grid=grid)
         free = grid[1]
-        straight = float(np.linalg.norm(a.goal_deg - a.start_deg))
-        optimal = grid_optimal_deg(s, grid=grid)
         fraction = float(1.0 - free.mean())
         # a passage narrower than the 2 deg grid can hide the solution RRT just proved exists
         grid_text = (f"grid-optimal {optimal:.1f} deg" if math.isfinite(optimal)
@@ -265,6 +337,8 @@ def generate_one(seed: int, k: int, prefix: str = "gen", family: str = "sample",
         desc = (f"generated (xfuzzy-rrt scenarios generate, seed {seed}, problem {k}{family_text}); "
                 f"{grid_text}, straight {straight:.1f} deg, "
                 f"C-obstacle fraction {fraction:.3f}")
+        if family == "trap":
+            desc += f", detour ratio {optimal / straight:.2f} (grid-optimal / straight)"
         text = scenario_toml(s, desc)
         final = scenario_from_dict(tomllib.loads(text), name)
         return GeneratedProblem(scenario=final, text=text, grid_optimal_deg=optimal,

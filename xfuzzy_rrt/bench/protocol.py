@@ -106,11 +106,21 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     rows = []
     total = len(scenarios) * len(entries)
     done = 0
+    # Warm-up, not recorded: each planner's first call in a process loads (or compiles) its
+    # kernels, OMPL's too, which is not the time a user waits for a plan.
+    if scenarios:
+        for _label, planner, rb in entries:
+            _one(scenarios[0], planner, rb, seed, min(max_iter, 100), clearance_m)
     for sc in scenarios:
-        for label, planner, rb in entries:
-            for k in range(runs):
-                rows.append({"scenario": sc.name, "planner": label, "seed": seed + k,
-                             **_one(sc, planner, rb, seed + k, max_iter, clearance_m)})
+        # Seeds outer, planners inner: every planner runs seed k under the same machine
+        # conditions, so a burst of load blurs all planners alike, not one planner's block.
+        per = {label: [] for label, _, _ in entries}
+        for k in range(runs):
+            for label, planner, rb in entries:
+                per[label].append({"scenario": sc.name, "planner": label, "seed": seed + k,
+                                   **_one(sc, planner, rb, seed + k, max_iter, clearance_m)})
+        for label, _, _ in entries:
+            rows.extend(per[label])
             done += 1
             if progress:
                 progress(done, total)

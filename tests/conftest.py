@@ -89,6 +89,14 @@ def _warm_numba_cache() -> None:
     for name in ("goal-frame", "expert"):
         plan_scenario(s, planner="fuzzy-rrt", rulebook=rulebooks_dir() / name, seed=0,
                       max_iter=20, trace=True)
+    plan_scenario(s, planner="fuzzy-rrt-connect", seed=0, max_iter=20, trace=True)
+    # The certificate and the exact minimum clearance (measured lazily, so no plan above
+    # compiled them): tests with a time limit must not pay for their first compile.
+    from xfuzzy_rrt.geometry.path_check import certify_path, path_min_clearance
+
+    a = s.arrays()
+    certify_path(a, [s.start_deg, s.goal_deg])
+    path_min_clearance(a, [s.start_deg, s.goal_deg])
 
 
 def pytest_configure(config):

@@ -183,12 +183,17 @@ def test_bench_json_records_scenario_hashes_and_rulebook(bench_dir):
     assert meta["settings"]["shortcut"] is True and meta["settings"]["max_iter"] == 600
 
 
+#: OMPL's RRTConnect checking motions by sampling them, at the range it had before tuning.
+SAMPLED = "ompl:RRTConnect:sampled:range=10"
+
+
 @pytest.fixture(scope="module")
 def ompl_bench(scenarios):
-    """RRT and OMPL's RRTConnect on two-circles, seeds 0-5 (seed 4 grazes a circle)."""
+    """RRT and OMPL's RRTConnect with OMPL's own sampled motion check at a 10 deg range on
+    two-circles, seeds 0-5 (seed 4 grazes a circle)."""
     from xfuzzy_rrt.bench.runner import run_benchmark
 
-    return run_benchmark(scenarios[:1], ["rrt", "ompl:RRTConnect"], runs=6, max_iter=5000,
+    return run_benchmark(scenarios[:1], ["rrt", SAMPLED], runs=6, max_iter=5000,
                          shortcut=True)
 
 
@@ -199,11 +204,11 @@ def test_ompl_rows_are_certified_exactly_when_the_exact_oracle_finds_no_collisio
     from xfuzzy_rrt.planners.api import plan_scenario
 
     oracle = Oracle(TWO_CIRCLES)
-    rows = ompl_bench.runs[ompl_bench.runs["planner"] == "ompl:RRTConnect"]
+    rows = ompl_bench.runs[ompl_bench.runs["planner"] == SAMPLED]
     assert rows["found"].all()
     assert not rows["certified"].all(), "fixture: one of these OMPL paths grazes an obstacle"
     for row in rows.itertuples(index=False):
-        again = plan_scenario(scenarios[0], "ompl:RRTConnect", seed=row.seed, max_iter=5000)
+        again = plan_scenario(scenarios[0], SAMPLED, seed=row.seed, max_iter=5000)
         assert again.iterations == row.iterations  # the same run, so the same path
         problems = oracle.path_problems(again.path_deg)
         dense = float(np.min(oracle.clearance(oracle.densify(again.path_deg, 0.02))))

@@ -149,7 +149,8 @@ def test_where_sampling_penetrates_the_certified_validator_returns_only_certifie
     # seeds; through the certified check every path is certified, on every seed.
     s = load_scenario(TWO_CIRCLES)
     oracle = Oracle(TWO_CIRCLES)
-    sampled = [plan_scenario(s, planner="ompl:RRTConnect:sampled", seed=k) for k in range(20)]
+    sampled = [plan_scenario(s, planner="ompl:RRTConnect:sampled:range=10", seed=k)
+               for k in range(20)]
     assert any(r.found and not r.certified and r.penetration_m > 0.0 for r in sampled)
     for seed in range(20):
         r = plan_scenario(s, planner="ompl:RRTConnect", seed=seed)
@@ -330,7 +331,7 @@ def test_unknown_and_unsupported_ompl_planners_are_one_clear_input_error():
         check_planner("ompl:PRM")
     assert info.value.where == "--planners"
     assert is_known_planner("ompl:RRT") and not is_known_planner("ompl:")
-    assert PLANNERS == ("rrt", "fuzzy-rrt")
+    assert PLANNERS == ("rrt", "fuzzy-rrt", "fuzzy-rrt-connect")
 
 
 def test_without_the_extra_ompl_planners_name_the_extra(monkeypatch, capsys):
@@ -366,10 +367,10 @@ def test_cli_plan_with_an_ompl_planner_repeats_across_processes(run_cli):
     # and message each time.
     runs = []
     for _ in range(2):
-        proc = run_cli("plan", TWO_CIRCLES, "--planner", "ompl:RRTConnect:sampled", "--seed",
-                       "4")
+        proc = run_cli("plan", TWO_CIRCLES, "--planner", "ompl:RRTConnect:sampled:range=10",
+                       "--seed", "4")
         assert proc.returncode == 1, proc.stderr
-        assert proc.stderr == (f"not certified: {TWO_CIRCLES}: ompl:RRTConnect:sampled seed 4: "
+        assert proc.stderr == (f"not certified: {TWO_CIRCLES}: ompl:RRTConnect:sampled:range=10 seed 4: "
                                "segment "
                                "38 penetrates an obstacle 0.03163 mm deep at q = (129.996, "
                                "-96.6686) deg\n")
@@ -379,7 +380,7 @@ def test_cli_plan_with_an_ompl_planner_repeats_across_processes(run_cli):
         data.pop("wall_s")
         runs.append(data)
     assert runs[0] == runs[1]
-    assert runs[0]["planner"] == "ompl:RRTConnect:sampled"
+    assert runs[0]["planner"] == "ompl:RRTConnect:sampled:range=10"
     assert runs[0]["params"]["ompl_seed"] == 5
     assert runs[0]["path_deg"][0] == [-120.0, 30.0] and runs[0]["path_deg"][-1] == [150.0, -60.0]
     # The same seed through the certified check: a certified path, exit 0, twice the same.

@@ -157,11 +157,18 @@ def segments_certified(arrays, path_deg, margin: float = CERT_MARGIN_M) -> int |
 
 
 def path_min_clearance(arrays, path_deg, margin: float = CERT_MARGIN_M) -> tuple[float, float]:
-    """``(min_clearance_m, penetration_m)`` of a path exactly as :func:`certify_path` reports
-    them, without certifying it: what a result computes only when someone asks (the branch and
-    bound costs more than most plans; see ``planners/result.py``)."""
+    """``(min_clearance_m, penetration_m)`` of a *certified* path as :func:`certify_path`
+    reports them, without certifying it again: what a result computes only when someone asks
+    (the branch and bound costs more than most plans; see ``planners/result.py``)."""
     path = np.ascontiguousarray(np.asarray(path_deg, dtype=np.float64))
-    value, _seg, _s = _min_clearance(arrays.problem(margin), path)
+    problem = arrays.problem(margin)
+    value, _seg, _s = _min_clearance(problem, path)
+    # Only certified paths are measured here (planners/result.py), and certification already
+    # proved that no configuration on them comes closer than the surgeon's clearance
+    # (geometry/collision.py). When the branch and bound runs out of budget -- a flat minimum,
+    # e.g. two non-adjacent links of a straight arm exactly one link apart over a whole
+    # segment -- its proven bound can be far looser than that; it never goes below it.
+    value = max(value, float(problem.clearance))
     return value, (max(0.0, -value) if math.isfinite(value) else 0.0)
 
 

@@ -31,7 +31,6 @@ def tuned_file_name(label: str) -> str:
     return label.replace(":", "-") + ".toml"
 
 
-@lru_cache(maxsize=64)
 def tuned_path(label: str) -> Path:
     return tuned_dir() / tuned_file_name(label)
 

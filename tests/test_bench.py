@@ -224,10 +224,10 @@ def test_ompl_rows_are_certified_exactly_when_the_exact_oracle_finds_no_collisio
         else:
             assert problems and row.min_clearance_m < 0.0 and not row.success
             assert np.isnan(row.cost_short_deg), "an uncertified path is never shortened"
-    worst = ompl_bench.worst_examples[("two-circles", "ompl:RRTConnect")]
+    worst = ompl_bench.worst_examples[("two-circles", SAMPLED)]
     assert worst.min_clearance_m == rows["min_clearance_m"].min() and not worst.certified
     assert worst.violation.startswith(f"segment ") and "penetrates an obstacle" in worst.violation
-    s = ompl_bench.summary.set_index("planner").loc["ompl:RRTConnect"]
+    s = ompl_bench.summary.set_index("planner").loc[SAMPLED]
     assert s["success_rate"] == rows["certified"].mean() < s["found_rate"] == 1.0
     assert s["certified_fraction"] == rows["certified"].mean()
     assert s["min_clearance_min_m"] == rows["min_clearance_m"].min() < 0.0
@@ -243,12 +243,12 @@ def test_ompl_is_compared_on_time_to_first_path_and_ours_on_iterations(ompl_benc
         g = runs[runs["planner"] == planner]
         return float(np.median(np.where(g["success"], g["time_first_s"], g["wall_s"])))
 
-    assert summary.loc["ompl:RRTConnect", "time_first_median_s"] == time_median("ompl:RRTConnect")
-    expected = time_median("rrt") / time_median("ompl:RRTConnect")
-    assert np.isnan(summary.loc["ompl:RRTConnect", "iter_ratio_vs_rrt"])
-    assert summary.loc["ompl:RRTConnect", "time_ratio_vs_rrt"] == pytest.approx(expected)
+    assert summary.loc[SAMPLED, "time_first_median_s"] == time_median(SAMPLED)
+    expected = time_median("rrt") / time_median(SAMPLED)
+    assert np.isnan(summary.loc[SAMPLED, "iter_ratio_vs_rrt"])
+    assert summary.loc[SAMPLED, "time_ratio_vs_rrt"] == pytest.approx(expected)
     row = ompl_bench.ratios.query("metric == 'time_first_s'").set_index("planner").loc[
-        "ompl:RRTConnect"]
+        SAMPLED]
     assert row["metric"] == "time_first_s" and row["ratio_median"] == pytest.approx(expected)
     assert row["ratio_geomean"] == pytest.approx(expected)
     ours = ratio_table(bench_dir[0].summary).query("metric == 'iterations'").set_index(

@@ -281,7 +281,14 @@ def self_clearance(P, seg):
 def n_distance_pairs(P):
     """Exact element distances one configuration costs: links x obstacles, link pairs of two
     arms and non-adjacent link pairs of one arm (the unit of ``P.work``)."""
-    n = P.links.shape[0] * P.obstacles.shape[0]
+    return P.links.shape[0] * P.obstacles.shape[0] + n_link_pairs(P)
+
+
+@nb.njit(cache=True, nogil=True)
+def n_link_pairs(P):
+    """Link pairs that can touch: pairs of links of two arms, and non-adjacent links of one
+    arm (shared by the work count and ``signed.n_elements``)."""
+    n = 0
     n_arms = P.arm_first.shape[0] - 1
     for a in range(n_arms):
         na = P.arm_first[a + 1] - P.arm_first[a]

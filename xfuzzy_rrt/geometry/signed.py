@@ -24,6 +24,7 @@ from xfuzzy_rrt.geometry.collision import (
     _point_segment_dist,
     link_motion_bound,
     link_segments_into,
+    n_link_pairs,
     self_pair_motion_bound,
     segment_obstacle_dist,
     segment_segment_dist,
@@ -108,15 +109,7 @@ def signed_segment_segment_dist(ax, ay, bx, by, cx, cy, dx, dy):
 def n_elements(P):
     """Links (each against the obstacles), pairs of links of different arms, and pairs of
     non-adjacent links of one arm."""
-    n = P.links.shape[0]
-    n_arms = P.arm_first.shape[0] - 1
-    for a in range(n_arms):
-        na = P.arm_first[a + 1] - P.arm_first[a]
-        if na >= 3:
-            n += (na - 1) * (na - 2) // 2
-        for b in range(a + 1, n_arms):
-            n += (P.arm_first[a + 1] - P.arm_first[a]) * (P.arm_first[b + 1] - P.arm_first[b])
-    return n
+    return P.links.shape[0] + n_link_pairs(P)
 
 
 @nb.njit(cache=True, nogil=True)

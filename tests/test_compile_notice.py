@@ -30,3 +30,18 @@ def test_a_warm_command_prints_no_compile_notice(run_cli, tmp_path):
     assert first.returncode in (0, 1), first.stderr
     again = run_cli("plan", scenario, "--planner", "rrt", "--seed", "1", "--max-iter", "500")
     assert "compiling planners" not in again.stderr  # every kernel came from numba's cache
+
+
+def test_commands_run_in_process_leave_no_listener_behind():
+    """Each in-process ``main()`` removes its listener when it ends; before this, twenty
+    earlier commands left twenty listeners and one later compile printed the notice 20 times."""
+    from numba.core import event
+
+    from xfuzzy_rrt.cli.main import main
+
+    before = len(event._registered.get("numba:compile", []))
+    for _ in range(3):
+        main(["plan", "--help"])  # --help: no listener at all
+        main(["plan", "no-such-file.toml"])  # exit 2 after the listener was registered
+    assert len(event._registered.get("numba:compile", [])) == before
+

@@ -16,8 +16,12 @@ from __future__ import annotations
 from typing import Callable
 
 
-def notify_first_compile(callback: Callable[[], None]) -> None:
-    """Call ``callback()`` once, in whichever process of this command first compiles a kernel."""
+def notify_first_compile(callback: Callable[[], None]) -> Callable[[], None]:
+    """Call ``callback()`` once, in whichever process of this command first compiles a kernel.
+
+    Returns the function that removes the listener: a command run in-process (tests, scripts
+    calling ``main()`` repeatedly) must not leave listeners behind that would each print the
+    notice on a later command's compile."""
     import multiprocessing
 
     from numba.core import event
@@ -35,4 +39,6 @@ def notify_first_compile(callback: Callable[[], None]) -> None:
         def on_end(self, ev) -> None:
             pass
 
-    event.register("numba:compile", _FirstCompile())
+    listener = _FirstCompile()
+    event.register("numba:compile", listener)
+    return lambda: event.unregister("numba:compile", listener)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import sys
+from typing import Callable
 
 import typer
 
@@ -61,26 +62,27 @@ _PLANNING = {"plan", "bench", "demo", "explain", "train", "tune", ("rules", "cov
              ("rules", "diff"), ("rules", "simplify"), ("scenarios", "generate")}
 
 
-def _announce_first_compile(args: list[str]) -> None:
+def _announce_first_compile(args: list[str]) -> Callable[[], None]:
     """One stderr line when numba starts compiling (the first run after an install takes tens
-    of seconds: say why rather than look hung). Nothing when the kernels come from its cache."""
+    of seconds: say why rather than look hung). Nothing when the kernels come from its cache.
+    Returns what removes the listener again (called when the command ends)."""
     words = [a for a in args if not a.startswith("-")][:2]
     if not words or "--help" in args or not (words[0] in _PLANNING or tuple(words) in _PLANNING):
-        return
+        return lambda: None
     from xfuzzy_rrt.compile_notice import notify_first_compile
 
     def say() -> None:
         sys.stderr.write("compiling planners, first run only…\n")
         sys.stderr.flush()
 
-    notify_first_compile(say)
+    return notify_first_compile(say)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; return (and, as a script, exit with) the process exit code."""
     args = sys.argv[1:] if argv is None else list(argv)
     command = typer.main.get_command(app)
-    _announce_first_compile(args)
+    stop_notice = _announce_first_compile(args)
     try:
         rv = command.main(args=args, prog_name="xfuzzy-rrt", standalone_mode=False)
     except RulebookError as exc:
@@ -113,6 +115,8 @@ def main(argv: list[str] | None = None) -> int:
         code = 130
     else:
         code = rv if isinstance(rv, int) else 0
+    finally:
+        stop_notice()
     if argv is None:
         if "ompl" in sys.modules:
             # OMPL 2.0.1's bindings (nanobind) keep some planner objects alive on purpose and

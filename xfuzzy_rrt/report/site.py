@@ -229,8 +229,10 @@ def _overview(ctx) -> str:
     page.add('<ul class="xf-verdict" id="verdict">'
              + "".join(f"<li>{esc(s)}</li>" for s in verdicts(table_, settings.get("tuned")))
              + "</ul>")
-    page.add(_planner_table(table_))
+    # The verdict and the ratio plot are the answer, so they come first: the table below can
+    # grow with the planners and its columns without pushing the plot off the first screen.
     page.add(_ratio_plot(ctx, runs))
+    page.add(_planner_table(table_))
     page.heading("Certification: the worst path of each planner", anchor="certification")
     _certification(ctx, page, table_)
     from xfuzzy_rrt.report.robustness_section import robustness_html

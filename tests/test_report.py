@@ -109,7 +109,7 @@ def test_overview_verdict_and_table_are_the_numbers_of_runs_csv(full):
     # The verdict and the ratio plot come before any other section (the first screen), and
     # before the planner table, whose height grows with its planners and columns.
     assert html.index('id="verdict"') < html.index('id="ratio-plot"') < html.index(
-        'xf-planners') < html.index('id="certification"')
+        'class="data xf-planners"') < html.index('id="certification"')
 
 
 def test_ratio_plot_points_link_to_their_scenario_pages(full):

@@ -191,7 +191,7 @@ def test_explain_finds_the_rulebook_that_made_a_default_any_arm_trace(tmp_path):
         assert "rulebook 'goal-frame-any'" in text and "Fuzzy-RRT-Connect" in text
 
 
-def test_bench_over_two_and_five_joints_runs_both_and_records_what_ran(tmp_path):
+def test_bench_over_two_and_five_joints_runs_both_and_records_what_ran_with_any_workers(tmp_path):
     from xfuzzy_rrt.bench.runner import run_benchmark
     from xfuzzy_rrt.geometry.scenario import load_scenario
 
@@ -207,6 +207,11 @@ def test_bench_over_two_and_five_joints_runs_both_and_records_what_ran(tmp_path)
     assert set(fz.loc[five.name, "rulebook_sha256"]) == {load_rulebook(ANY).sha256}
     assert fz["success"].all()
     assert set(runs.loc[runs["planner"] == "rrt", "planner_used"]) == {"rrt"}
+    # same seeds, same runs, whatever the number of workers (the wall-clock columns aside)
+    two_workers = run_benchmark([two, five], ["rrt", "fuzzy-rrt"], runs=2, max_iter=MAX_ITER,
+                                workers=2).runs
+    timed = ["wall_s", "time_first_s", "time_total_s"]
+    pd.testing.assert_frame_equal(runs.drop(columns=timed), two_workers.drop(columns=timed))
     # one row per planner in the tables, both rulebooks in the benchmark's record
     assert sorted(set(res.summary["planner"])) == ["fuzzy-rrt", "rrt"]
     listed = {e["planner"]: e["name"] for e in res.settings["rulebooks"]}
@@ -232,6 +237,20 @@ def test_bench_over_two_and_five_joints_runs_both_and_records_what_ran(tmp_path)
     assert "Follow one plan" in page and "goal-frame-any" in page
     assert f"--planner fuzzy-rrt --seed {example.seed} --max-iter {MAX_ITER}" in page
     assert "--rulebook" not in page
+
+
+def test_evaluate_without_a_rulebook_runs_the_default_of_each_problem(tmp_path):
+    out = tmp_path / "ev"
+    code, text, err = run_main(["evaluate", TWO_JOINTS, _write(one_arm(3), tmp_path), "--runs",
+                                "1", "--no-tuned", "--max-iter", "1000", "--out", out])
+    assert code == 0, err
+    runs = pd.read_csv(out / "runs.csv")
+    fz = runs[runs["planner"] == "fuzzy-rrt"]
+    assert dict(zip(fz["scenario"], fz["planner_used"])) == {
+        "two-circles": "fuzzy-rrt", "any-arm3": "fuzzy-rrt-connect"}
+    assert dict(zip(fz["scenario"], fz["rulebook"])) == {
+        "two-circles": "goal-frame", "any-arm3": "goal-frame-any"}
+    assert fz["success"].all()
 
 
 def _scenario_page(result, name: str) -> str:

@@ -114,12 +114,6 @@ def load_shipped_default() -> ShippedDefault:
                           load_rulebook(default_rulebook_dir(ANY_ARM_PLANNER)))
 
 
-def planner_used_of(spec: "PlannerSpec") -> str:
-    """The planner a label runs, as ``--planner`` names it without a rulebook: ``fuzzy-rrt``
-    or ``fuzzy-rrt-connect`` for their ``:NAME`` labels, the label itself otherwise."""
-    return spec.kind if spec.kind in RULEBOOK_KINDS else spec.label
-
-
 def shipped_rulebook_names() -> list[str]:
     from xfuzzy_rrt.fuzzy.rulebook import list_rulebooks
 

@@ -20,7 +20,9 @@ def plan(
     scenario: Path = typer.Argument(..., help="Scenario TOML file."),
     planner: str = typer.Option(
         PlannerName.fuzzy_rrt.value, "--planner",
-        help="Planner: rrt, fuzzy-rrt, fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, "
+        help="Planner: rrt, fuzzy-rrt (without --rulebook: goal-frame on one 2-joint arm, else "
+             "fuzzy-rrt-connect with goal-frame-any; the JSON's planner_used says which ran), "
+             "fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, "
              "fuzzy-rrt-connect[:NAME|:DIR] (two goal-frame trees; default rulebook goal-frame-any, any arm), or "
              "ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
     rulebook: Optional[Path] = typer.Option(

@@ -274,3 +274,14 @@ def test_bench_with_a_named_rulebook_that_does_not_fit_fails_before_planning(tmp
     five = load_scenario(FIXTURES / "arms" / "five-dof.toml")
     with pytest.raises(InputError, match="name no rulebook"):
         run_benchmark([five], ["fuzzy-rrt"], runs=1, rulebook=rulebooks_dir() / "goal-frame")
+
+
+def test_bench_runs_fuzzy_rrt_connect_by_name_on_any_arm():
+    # the pre-run check of every (problem, rulebook) pair checks a fuzzy-rrt-connect label as
+    # Fuzzy-RRT-Connect does (a DOF-free rulebook fits every arm), not as Fuzzy-RRT
+    from xfuzzy_rrt.bench.runner import run_benchmark
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    five = load_scenario(FIXTURES / "arms" / "five-dof.toml")
+    runs = run_benchmark([five], ["fuzzy-rrt-connect"], runs=1, max_iter=MAX_ITER).runs
+    assert runs["success"].all() and list(runs["rulebook"]) == ["goal-frame-any"]

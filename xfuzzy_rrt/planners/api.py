@@ -24,9 +24,9 @@ CONNECT_PREFIX = "fuzzy-rrt-connect:"
 #: Planner kinds that take a rulebook (and can record traces).
 RULEBOOK_KINDS = ("fuzzy-rrt", "fuzzy-rrt-connect")
 #: What plain ``fuzzy-rrt`` runs, with no rulebook named, on a problem that is not one 2-joint
-#: arm (see :func:`shipped_default`): the planner and the DOF-free rulebook that plan any arm.
+#: arm (see :func:`shipped_default`), with that planner's own default, the DOF-free
+#: ``goal-frame-any``.
 ANY_ARM_PLANNER = "fuzzy-rrt-connect"
-ANY_ARM_RULEBOOK = "goal-frame-any"
 #: The key under which a benchmark lists the any-arm rulebook of plain ``fuzzy-rrt`` beside the
 #: 2-joint one (``BenchResult.rulebooks``, ``bench.json``): the runs keep the label ``fuzzy-rrt``.
 ANY_ARM_KEY = "fuzzy-rrt (any arm)"
@@ -79,10 +79,12 @@ def shipped_default(scenario: Scenario) -> tuple[str, Path]:
 
     The rule: one 2-joint arm -> ``fuzzy-rrt`` with the shipped default (``goal-frame``); any
     other problem (one arm of 3-7 joints, or 2-4 arms) -> ``fuzzy-rrt-connect`` with the
-    DOF-free ``goal-frame-any``. Why per problem: at 2 joints goal-frame Fuzzy-RRT is the faster
-    of the two (Connect 0.61-0.73x of it with the fair protocol), beyond two it does not fit at
-    all, and Connect with ``goal-frame-any`` beats the per-DOF rulebooks there (5 joints: a
-    median 1.33x ``rrt:tuned``, 100 % certified success against ``goal-frame-5dof``'s 64 %).
+    DOF-free ``goal-frame-any``. Why per problem (the fair protocol, end-to-end time against
+    ``rrt:tuned``, medians over 48 unseen problems per family; README): at 2 joints goal-frame
+    Fuzzy-RRT is the faster of the two (1.01-1.24x against Connect's 0.61-0.73x); beyond two it
+    does not fit at all, and Connect with ``goal-frame-any`` beats the per-DOF rulebooks there
+    (5 joints 1.33x and 100 % certified success against ``goal-frame-5dof``'s 0.91x and 64 %;
+    two 3-joint arms 2.09x against ``goal-frame-dual3``'s 1.25x).
     Only this default adapts: a rulebook the user names that does not fit stays an error.
     """
     if is_two_joint_problem(scenario):

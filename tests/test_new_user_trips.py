@@ -154,8 +154,10 @@ def test_a_rulebook_given_to_a_planner_without_rules_is_refused(run_cli, tmp_pat
 
 
 def test_bench_finds_a_rulebook_dof_mismatch_before_any_planning(run_cli, tmp_path):
+    # a rulebook the user names (without one, fuzzy-rrt plans the 5-DOF problem with its
+    # any-arm default: tests/test_default_plans_any_arm.py)
     proc = run_cli("bench", SCENARIO, FIVE_DOF, "--planners", "rrt,fuzzy-rrt", "--runs", "2",
-                   "--out", tmp_path / "b")
+                   "--rulebook", PROJECT / "rulebooks" / "goal-frame", "--out", tmp_path / "b")
     _one_error_line(proc, "five-dof", "DOF")
     assert "bench:" not in proc.stderr  # no progress line: nothing ran
     assert not (tmp_path / "b").exists()

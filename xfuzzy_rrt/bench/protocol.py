@@ -61,7 +61,8 @@ SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "wors
                    "worst_work_total_ratio", "problems_lost_work_total", "median_time_total_s",
                    "median_work", "median_work_total"]
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "cost_deg", "wall_s",
-               "time_total_s", "work", "work_total"]
+               "time_total_s", "work", "work_total", "planner_used", "rulebook",
+               "rulebook_sha256"]
 BASELINE = "rrt"
 TUNED_BASELINE = "rrt:tuned"
 
@@ -88,7 +89,11 @@ def _one(scenario, planner: str, rulebook, seed: int, max_iter: int, clearance_m
             "cost_deg": float(r.cost_deg) if ok and r.cost_deg is not None else np.nan,
             "wall_s": float(r.wall_s), "time_total_s": total,
             "work": np.nan if work is None else float(work),
-            "work_total": np.nan if work is None else float(work + r.certify_work)}
+            "work_total": np.nan if work is None else float(work + r.certify_work),
+            # what ran (plain fuzzy-rrt's shipped default differs per problem: api.shipped_default)
+            "planner_used": getattr(r, "planner_used", None) or r.planner,
+            "rulebook": getattr(r, "rulebook", None),
+            "rulebook_sha256": getattr(r, "rulebook_sha256", None)}
 
 
 def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs: int = 50,
@@ -100,7 +105,9 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     ``clearance_m`` is the certified margin every planner must keep (``None``: each scenario's).
 
     ``planner`` is a name :func:`~xfuzzy_rrt.planners.api.plan_scenario` takes (``fuzzy-rrt``
-    with a loaded ``rulebook``, or ``ompl:NAME``); ``label`` names it in the tables.
+    with a loaded ``rulebook`` or the :class:`~xfuzzy_rrt.planners.api.ShippedDefault`, or
+    ``ompl:NAME``); ``label`` names it in the tables, ``planner_used``/``rulebook`` in the runs
+    say what ran.
     """
     entries = [("rrt", "rrt", None), *planners]
     rows = []
@@ -108,9 +115,16 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     done = 0
     # Warm-up, not recorded: each planner's first call in a process loads (or compiles) its
     # kernels, OMPL's too, which is not the time a user waits for a plan.
+    # Plain fuzzy-rrt runs another planner on a problem that is not one 2-joint arm, so the
+    # first problem of the other kind warms up too.
     if scenarios:
-        for _label, planner, rb in entries:
-            _one(scenarios[0], planner, rb, seed, min(max_iter, 100), clearance_m)
+        from xfuzzy_rrt.planners.api import is_two_joint_problem
+
+        kind = is_two_joint_problem(scenarios[0])
+        warm = [scenarios[0], *[s for s in scenarios if is_two_joint_problem(s) != kind][:1]]
+        for sc in warm:
+            for _label, planner, rb in entries:
+                _one(sc, planner, rb, seed, min(max_iter, 100), clearance_m)
     for sc in scenarios:
         # Seeds outer, planners inner: every planner runs seed k under the same machine
         # conditions, so a burst of load blurs all planners alike, not one planner's block.

@@ -24,6 +24,13 @@ Several rulebooks can run side by side: ``fuzzy-rrt:NAME`` (a shipped rulebook) 
 ``fuzzy-rrt:DIR`` is its own planner label, with its own rows; plain ``fuzzy-rrt`` is the
 ``rulebook`` argument or the shipped default. Every label is validated (and every rulebook
 loaded) before the first run.
+
+**The shipped default plans any arm.** Plain ``fuzzy-rrt`` without a ``rulebook`` runs, per
+problem, :func:`~xfuzzy_rrt.planners.api.shipped_default`'s choice: ``goal-frame`` on one
+2-joint arm, Fuzzy-RRT-Connect with ``goal-frame-any`` on any other. Its rows keep the label
+``fuzzy-rrt`` (one row per planner, whatever the mix of problems); ``planner_used``,
+``rulebook`` and ``rulebook_sha256`` in each row say what ran, and the benchmark lists both
+rulebooks (the any-arm one under :data:`~xfuzzy_rrt.planners.api.ANY_ARM_KEY` when both ran).
 """
 
 from __future__ import annotations
@@ -49,7 +56,7 @@ from xfuzzy_rrt.planners.result import PlanResult, path_cost_deg
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "nodes", "cost_deg",
                "wall_s", "time_first_s", "found", "certified", "min_clearance_m",
                "penetration_m", "rulebook", "rulebook_sha256", "time_total_s", "work",
-               "certify_work", "work_total"]
+               "certify_work", "work_total", "planner_used"]
 #: Shortcutting attempts per path (the OMPL helper's default).
 SHORTCUT_ATTEMPTS = 200
 
@@ -155,6 +162,7 @@ def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
         "time_total_s": time_total, "work": np.nan if r.work is None else int(r.work),
         "certify_work": int(r.certify_work),
         "work_total": np.nan if r.work is None else int(r.work) + int(r.certify_work),
+        "planner_used": r.planner_used or r.planner,
     }
     if job.shortcut:
         row["cost_short_deg"] = np.nan
@@ -173,25 +181,92 @@ def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
 def check_pairs(scenarios: list[Scenario], rulebooks: dict[str, Any]) -> None:
     """Every (scenario, Fuzzy-RRT rulebook) pair fits -- the rulebook's DOF drives the arms --
     checked before the first run, so a 5-DOF problem among 2-DOF ones fails at once rather
-    than after the runs before it (one line naming the scenario file and the rulebook)."""
+    than after the runs before it (one line naming the scenario file and the rulebook).
+
+    ``rulebooks``: label -> what its jobs get (:func:`job_rulebooks`); the shipped default of
+    plain ``fuzzy-rrt`` fits every problem by construction, a ``fuzzy-rrt-connect`` label is
+    checked as Fuzzy-RRT-Connect checks it (a DOF-free rulebook fits every arm)."""
+    from xfuzzy_rrt.planners.api import ShippedDefault, parse_planner
     from xfuzzy_rrt.planners.checks import check_dof
+    from xfuzzy_rrt.planners.connect import check_connect_rulebook
     from xfuzzy_rrt.planners.fuzzy_rrt import check_rulebook_fits
 
+    kinds = {label: parse_planner(label).kind for label in rulebooks}
     for s in scenarios:
         check_dof(s)
-        for rb in rulebooks.values():
-            check_rulebook_fits(rb, s)
+        for label, rb in rulebooks.items():
+            if isinstance(rb, ShippedDefault):
+                continue
+            if kinds[label] == "fuzzy-rrt-connect":
+                check_connect_rulebook(rb, s)
+            else:
+                check_rulebook_fits(rb, s)
 
 
-def _warm_up(scenario: Scenario, planners: list[str], rulebooks: dict[str, Any]) -> None:
+def job_rulebooks(planners: list[str], rulebooks: dict[str, Any], rulebook=None) -> dict[str, Any]:
+    """Label -> what :func:`plan_scenario` gets as ``rulebook`` in that label's jobs: the loaded
+    rulebook, or for plain ``fuzzy-rrt`` without a ``rulebook`` the shipped default with both
+    its rulebooks loaded once (:class:`~xfuzzy_rrt.planners.api.ShippedDefault`), so that each
+    problem runs its own default and no run re-reads a rulebook."""
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+    from xfuzzy_rrt.planners.api import ANY_ARM_PLANNER, ShippedDefault, default_rulebook_dir
+
+    out = dict(rulebooks)
+    if "fuzzy-rrt" in planners and rulebook is None and "fuzzy-rrt" in rulebooks:
+        out["fuzzy-rrt"] = ShippedDefault(rulebooks["fuzzy-rrt"],
+                                          load_rulebook(default_rulebook_dir(ANY_ARM_PLANNER)))
+    return out
+
+
+def ran_rulebooks(scenarios: list[Scenario], rulebooks: dict[str, Any],
+                  dirs: dict[str, str | None], jobs_rb: dict[str, Any]
+                  ) -> tuple[dict[str, Any], dict[str, str | None]]:
+    """The rulebooks the benchmark ran, for its tables and report: ``rulebooks`` as loaded,
+    except that the shipped default of plain ``fuzzy-rrt`` lists what the problems used --
+    ``goal-frame`` under ``fuzzy-rrt`` when a problem is one 2-joint arm, ``goal-frame-any``
+    under :data:`~xfuzzy_rrt.planners.api.ANY_ARM_KEY` when another problem is not (under
+    ``fuzzy-rrt`` itself when no problem is)."""
+    from xfuzzy_rrt.planners.api import (ANY_ARM_KEY, ANY_ARM_PLANNER, ShippedDefault,
+                                         default_rulebook_dir, is_two_joint_problem)
+
+    shipped = jobs_rb.get("fuzzy-rrt")
+    if not isinstance(shipped, ShippedDefault):
+        return dict(rulebooks), dict(dirs)
+    two = any(is_two_joint_problem(s) for s in scenarios)
+    other = not all(is_two_joint_problem(s) for s in scenarios)
+    any_dir = str(default_rulebook_dir(ANY_ARM_PLANNER).resolve())
+    books, where = {}, {}
+    for label, rb in rulebooks.items():
+        if label != "fuzzy-rrt":
+            books[label], where[label] = rb, dirs.get(label)
+        elif two:
+            books[label], where[label] = rb, dirs.get(label)
+            if other:
+                books[ANY_ARM_KEY], where[ANY_ARM_KEY] = shipped.any_arm, any_dir
+        else:
+            books[label], where[label] = shipped.any_arm, any_dir
+    return books, where
+
+
+def _warm_up(scenarios: list[Scenario], planners: list[str], rulebooks: dict[str, Any]) -> None:
     """Compile/load the kernels once so that no timed run pays JIT cost.
 
     Also the first call of every planner through the API: an unusable ``ompl:NAME`` fails
-    here, before any run.
+    here, before any run. ``scenarios``: the first problem, and the first one that is not
+    like it (one 2-joint arm or not), since plain ``fuzzy-rrt`` runs another planner there.
     """
-    for planner in planners:
-        plan_scenario(scenario, planner=planner, rulebook=rulebooks.get(planner), seed=0,
-                      max_iter=5)
+    for scenario in scenarios:
+        for planner in planners:
+            plan_scenario(scenario, planner=planner, rulebook=rulebooks.get(planner), seed=0,
+                          max_iter=5)
+
+
+def _warm_up_scenarios(scenarios: list[Scenario]) -> list[Scenario]:
+    from xfuzzy_rrt.planners.api import is_two_joint_problem
+
+    first = is_two_joint_problem(scenarios[0])
+    other = next((s for s in scenarios if is_two_joint_problem(s) != first), None)
+    return [scenarios[0]] + ([other] if other is not None else [])
 
 
 def _die_with_parent(parent: int) -> None:
@@ -209,7 +284,7 @@ def _die_with_parent(parent: int) -> None:
         os._exit(1)
 
 
-def _worker_init(parent: int, scenario: Scenario, planners: list[str],
+def _worker_init(parent: int, scenarios: list[Scenario], planners: list[str],
                  rulebooks: dict[str, Any]) -> None:
     """Worker start-up: die with the parent, leave Ctrl-C to it (it cancels the pool and
     reports once; a worker's KeyboardInterrupt traceback is noise), then warm up."""
@@ -217,7 +292,7 @@ def _worker_init(parent: int, scenario: Scenario, planners: list[str],
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(AttributeError, ValueError):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-    _warm_up(scenario, planners, rulebooks)
+    _warm_up(scenarios, planners, rulebooks)
 
 
 def _median_run_seed(group: pd.DataFrame) -> int | None:
@@ -258,11 +333,14 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
     if len(set(names)) != len(names):
         dup = sorted({n for n in names if names.count(n) > 1})[0]
         raise InputError("scenarios", f"two scenario files share the name {dup!r}")
-    rulebooks, rulebook_dirs = load_rulebooks(planners, rulebook)
-    check_pairs(scenarios, rulebooks)
-    jobs = [_Job(s, p, rulebooks.get(p), seed + k, max_iter, shortcut)
+    loaded, loaded_dirs = load_rulebooks(planners, rulebook)
+    jobs_rb = job_rulebooks(planners, loaded, rulebook)
+    check_pairs(scenarios, jobs_rb)
+    rulebooks, rulebook_dirs = ran_rulebooks(scenarios, loaded, loaded_dirs, jobs_rb)
+    jobs = [_Job(s, p, jobs_rb.get(p), seed + k, max_iter, shortcut)
             for s in scenarios for p in planners for k in range(runs)]
-    _warm_up(scenarios[0], planners, rulebooks)
+    warm = _warm_up_scenarios(scenarios)
+    _warm_up(warm, planners, jobs_rb)
     outputs: list[tuple[PlanResult, dict[str, Any]]] = []
     if workers == 1:
         for j in jobs:
@@ -270,8 +348,7 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
             if progress is not None:
                 progress(len(outputs), len(jobs))
     else:
-        outputs = _run_pool(jobs, workers, (os.getpid(), scenarios[0], planners, rulebooks),
-                            progress)
+        outputs = _run_pool(jobs, workers, (os.getpid(), warm, planners, jobs_rb), progress)
     columns = RUN_COLUMNS + (["cost_short_deg"] if shortcut else [])
     runs_df = pd.DataFrame([row for _, row in outputs], columns=columns)
     for col in ("success", "found", "certified"):
@@ -287,10 +364,10 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
         if seed_ is None:
             continue
         example = by_run[(scen, planner, seed_)]
-        if planner in rulebooks:
+        if planner in jobs_rb:
             # Re-run the example with tracing (deterministic: the same run, plus its trace)
             # so the report can show what the fuzzy systems decided.
-            example = plan_scenario(by_name[scen], planner=planner, rulebook=rulebooks[planner],
+            example = plan_scenario(by_name[scen], planner=planner, rulebook=jobs_rb[planner],
                                     seed=seed_, max_iter=max_iter, trace=True)
         examples[(scen, planner)] = example
     worst = {}

@@ -154,8 +154,9 @@ def _write_examples(result: BenchResult, folder: Path) -> None:
         known = stems.get((scen, planner, int(r.seed)))
         if known is None:
             stem = f"e{len(stems):03d}"
-            tree = pd.DataFrame({"q1_deg": np.asarray(r.tree_nodes_deg, dtype=np.float64)[:, 0],
-                                 "q2_deg": np.asarray(r.tree_nodes_deg, dtype=np.float64)[:, 1],
+            nodes = np.asarray(r.tree_nodes_deg, dtype=np.float64)
+            # every joint (q1_deg .. qN_deg): an N-DOF example reads back whole
+            tree = pd.DataFrame({**{f"q{j + 1}_deg": nodes[:, j] for j in range(nodes.shape[1])},
                                  "parent": np.asarray(r.tree_parent, dtype=np.int64)})
             with atomic_path(folder / f"{stem}-tree.parquet") as tmp:
                 tree.to_parquet(tmp, index=False)
@@ -166,7 +167,8 @@ def _write_examples(result: BenchResult, folder: Path) -> None:
                     r.trace.to_parquet(tmp, index=False)
             known = stems[(scen, planner, int(r.seed))] = (f"{stem}-tree.parquet", trace_file)
         index.append({
-            "role": role, "scenario": scen, "planner": planner, "seed": int(r.seed),
+            "role": role, "scenario": scen, "planner": planner,
+            "planner_used": r.planner_used or r.planner, "seed": int(r.seed),
             "success": bool(r.success), "found": bool(r.found), "certified": bool(r.certified),
             "min_clearance_m": r.min_clearance_m, "penetration_m": r.penetration_m,
             "violation": r.violation, "iterations": int(r.iterations), "nodes": int(r.nodes),
@@ -416,7 +418,9 @@ def _read_examples(folder: Path) -> tuple[dict[tuple[str, str], PlanResult],
             trace = pd.read_parquet(folder / e["trace"]) if e.get("trace") else None
         except Exception as exc:  # missing or unreadable parquet
             raise InputError(str(folder), f"example {e.get('tree')}: cannot read: {exc}") from None
-        path = np.asarray(e["path_deg"], dtype=np.float64).reshape(-1, 2)
+        joints = [c for c in tree.columns if c.startswith("q") and c.endswith("_deg")]
+        joints.sort(key=lambda c: int(c[1:-4]))  # q1_deg .. qN_deg (folders before: q1, q2)
+        path = np.asarray(e["path_deg"], dtype=np.float64).reshape(-1, len(joints))
         # Folders written before found/certified existed: their "success" meant "found", and
         # only certified examples were drawn.
         found = bool(e.get("found", e["success"]))
@@ -427,8 +431,9 @@ def _read_examples(folder: Path) -> tuple[dict[tuple[str, str], PlanResult],
             min_clearance_m=e.get("min_clearance_m"), penetration_m=e.get("penetration_m"),
             violation=e.get("violation"), iterations=int(e["iterations"]), nodes=int(e["nodes"]),
             cost_deg=e["cost_deg"], wall_s=float(e["wall_s"]), path_deg=path,
-            tree_nodes_deg=tree[["q1_deg", "q2_deg"]].to_numpy(dtype=np.float64),
+            tree_nodes_deg=tree[joints].to_numpy(dtype=np.float64),
             tree_parent=tree["parent"].to_numpy(dtype=np.int64), rulebook=e.get("rulebook"),
             rulebook_sha256=e.get("rulebook_sha256"), params=dict(e.get("params") or {}),
-            trace=trace, work=None if e.get("work") is None else int(e["work"]))
+            trace=trace, work=None if e.get("work") is None else int(e["work"]),
+            planner_used=e.get("planner_used"))
     return out, worst

@@ -122,7 +122,9 @@ def bench(
     scenarios: List[Path] = typer.Argument(..., help="Scenario TOML files or directories of them."),
     planners: str = typer.Option(
         "rrt,fuzzy-rrt", "--planners",
-        help="Comma list: rrt, fuzzy-rrt (the --rulebook or default rulebook), "
+        help="Comma list: rrt, fuzzy-rrt (the --rulebook, else the default of each problem: "
+             "goal-frame on one 2-joint arm, fuzzy-rrt-connect with goal-frame-any on others; "
+             "runs.csv's planner_used says which ran), "
              "fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR (a rulebook directory; "
              "several side by side), ompl:NAME (e.g. ompl:RRTConnect)."),
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),

@@ -32,7 +32,7 @@ def _fmt(v: float, unit: str = "") -> str:
 
 def evaluate(
     problems: List[Path] = typer.Argument(..., help="Scenario files or folders (a folder: every *.toml in it). Use problems no training or tuning saw."),
-    rulebook: List[str] = typer.Option([], "--rulebook", help="Rulebook name or directory to evaluate (repeatable; default: the shipped default rulebook)."),
+    rulebook: List[str] = typer.Option([], "--rulebook", help="Rulebook name or directory to evaluate (repeatable; default: the shipped default, fuzzy-rrt:goal-frame when every problem is one 2-joint arm, else fuzzy-rrt: goal-frame on such problems and fuzzy-rrt-connect with goal-frame-any on the others)."),
     peer: List[str] = typer.Option([], "--peer", help="Also run this planner, e.g. ompl:RRTConnect (repeatable; ranked on time)."),
     tuned: bool = typer.Option(True, "--tuned/--no-tuned", help="Run the tuned RRT (rrt:tuned) beside the paper's RRT and rank time and work against it (default: yes)."),
     runs: int = typer.Option(50, "--runs", help="Seeds per problem (seed .. seed + runs - 1, the same for every planner)."),
@@ -60,6 +60,7 @@ def evaluate(
         check_clearance(clearance)
     if out is not None and out.exists() and not out.is_dir():
         raise InputError(str(out), "exists and is not a directory")
+    named = bool(rulebook)
     if not rulebook:
         from xfuzzy_rrt.fuzzy.rulebook import DEFAULT_RULEBOOK
 
@@ -76,6 +77,14 @@ def evaluate(
     if len(set(labels)) != len(labels):
         raise InputError("--rulebook", "two planners share a name; give each rulebook once")
     scenarios = [load_scenario(f) for f in scenario_files(problems)]
+    from xfuzzy_rrt.planners.api import is_two_joint_problem, load_shipped_default
+
+    if not named and not all(is_two_joint_problem(sc) for sc in scenarios):
+        # No rulebook named and not every problem is one 2-joint arm: the shipped default per
+        # problem (goal-frame there, fuzzy-rrt-connect with goal-frame-any elsewhere), under
+        # the label plain fuzzy-rrt; runs.csv's planner_used and rulebook say which ran.
+        k = next(i for i, e in enumerate(entries) if e[1] == "fuzzy-rrt")
+        entries[k] = ("fuzzy-rrt", "fuzzy-rrt", load_shipped_default())
     if clearance is not None:
         # a batch protocol reports problems that no path can solve at this margin (start or
         # goal inside it) and goes on with the others; plan and bench refuse them outright

@@ -20,11 +20,13 @@ def plan(
     scenario: Path = typer.Argument(..., help="Scenario TOML file."),
     planner: str = typer.Option(
         PlannerName.fuzzy_rrt.value, "--planner",
-        help="Planner: rrt, fuzzy-rrt, fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, "
+        help="Planner: rrt, fuzzy-rrt (without --rulebook: goal-frame on one 2-joint arm, else "
+             "fuzzy-rrt-connect with goal-frame-any; the JSON's planner_used says which ran), "
+             "fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, "
              "fuzzy-rrt-connect[:NAME|:DIR] (two goal-frame trees; default rulebook goal-frame-any, any arm), or "
              "ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
     rulebook: Optional[Path] = typer.Option(
-        None, "--rulebook", help="Rulebook directory (fuzzy-rrt, fuzzy-rrt-connect; default: the planner's shipped default)."),
+        None, "--rulebook", help="Rulebook directory (fuzzy-rrt; default: the shipped default of the problem: goal-frame for one 2-joint arm, else fuzzy-rrt-connect with goal-frame-any, as the JSON's planner_used and rulebook say)."),
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Random seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON here (default: stdout)."),
@@ -67,13 +69,20 @@ def plan(
     if spec.kind in RULEBOOK_KINDS:
         from xfuzzy_rrt.errors import InputError
         from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
-        from xfuzzy_rrt.planners.api import default_rulebook_dir
+        from xfuzzy_rrt.planners.api import default_rulebook_dir, shipped_default
 
         if spec.rulebook_dir is not None and rulebook is not None:
             raise InputError("--rulebook", f"conflicts with --planner {planner} (which names "
                              "its own rulebook); give only one")
-        rulebook_dir = spec.rulebook_dir or rulebook or default_rulebook_dir(spec.kind)
-        rulebook_obj = load_rulebook(rulebook_dir)
+        rulebook_dir = spec.rulebook_dir or rulebook
+        if rulebook_dir is None and spec.kind == "fuzzy-rrt":
+            # No rulebook named: this problem's shipped default (goal-frame for one 2-joint
+            # arm, else fuzzy-rrt-connect with goal-frame-any). plan_scenario applies the same
+            # rule to rulebook=None; the JSON's planner_used and rulebook say which ran.
+            rulebook_dir = shipped_default(s)[1]
+        else:
+            rulebook_dir = rulebook_dir or default_rulebook_dir(spec.kind)
+            rulebook_obj = load_rulebook(rulebook_dir)
     result = plan_scenario(
         s, planner=planner, rulebook=rulebook_obj, seed=seed, max_iter=max_iter,
         step_deg=step_deg, goal_bias=goal_bias, trace=trace is not None, clearance_m=clearance,
@@ -86,7 +95,7 @@ def plan(
     data = result.to_json_dict()
     # Where the inputs came from, so that 'xfuzzy-rrt explain RESULT.json' can replay the run.
     data["scenario_file"] = str(scenario.resolve())
-    data["rulebook_dir"] = str(Path(rulebook_dir).resolve()) if rulebook_obj is not None else None
+    data["rulebook_dir"] = str(Path(rulebook_dir).resolve()) if rulebook_dir is not None else None
     emit_json(data, out)
     if result.found and not result.certified:
         import sys

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import Scenario
@@ -22,6 +23,13 @@ RRT_TUNED = "rrt:tuned"
 CONNECT_PREFIX = "fuzzy-rrt-connect:"
 #: Planner kinds that take a rulebook (and can record traces).
 RULEBOOK_KINDS = ("fuzzy-rrt", "fuzzy-rrt-connect")
+#: What plain ``fuzzy-rrt`` runs, with no rulebook named, on a problem that is not one 2-joint
+#: arm (see :func:`shipped_default`), with that planner's own default, the DOF-free
+#: ``goal-frame-any``.
+ANY_ARM_PLANNER = "fuzzy-rrt-connect"
+#: The key under which a benchmark lists the any-arm rulebook of plain ``fuzzy-rrt`` beside the
+#: 2-joint one (``BenchResult.rulebooks``, ``bench.json``): the runs keep the label ``fuzzy-rrt``.
+ANY_ARM_KEY = "fuzzy-rrt (any arm)"
 
 
 @dataclass(frozen=True)
@@ -58,6 +66,54 @@ def default_rulebook_dir(kind: str) -> Path:
 
         return rulebooks_dir() / DEFAULT_RULEBOOK
     return default_rulebook_path()
+
+
+def is_two_joint_problem(scenario: Scenario) -> bool:
+    """One arm of two joints: the problems the shipped ``goal-frame`` rulebook was made for."""
+    return len(scenario.arms) == 1 and scenario.arms[0].dof == 2
+
+
+def shipped_default(scenario: Scenario) -> tuple[str, Path]:
+    """``(planner, rulebook directory)`` that plain ``fuzzy-rrt`` runs on *scenario* when the
+    user names no rulebook (no ``--rulebook``, no ``fuzzy-rrt:NAME``, ``rulebook=None``).
+
+    The rule: one 2-joint arm -> ``fuzzy-rrt`` with the shipped default (``goal-frame``); any
+    other problem (one arm of 3-7 joints, or 2-4 arms) -> ``fuzzy-rrt-connect`` with the
+    DOF-free ``goal-frame-any``. Why per problem (the fair protocol, end-to-end time against
+    ``rrt:tuned``, medians over 48 unseen problems per family; README): at 2 joints goal-frame
+    Fuzzy-RRT is the faster of the two (1.01-1.24x against Connect's 0.61-0.73x); beyond two it
+    does not fit at all, and Connect with ``goal-frame-any`` beats the per-DOF rulebooks there
+    (5 joints 1.33x and 100 % certified success against ``goal-frame-5dof``'s 0.91x and 64 %;
+    two 3-joint arms 2.09x against ``goal-frame-dual3``'s 1.25x).
+    Only this default adapts: a rulebook the user names that does not fit stays an error.
+    """
+    if is_two_joint_problem(scenario):
+        return "fuzzy-rrt", default_rulebook_dir("fuzzy-rrt")
+    return ANY_ARM_PLANNER, default_rulebook_dir(ANY_ARM_PLANNER)
+
+
+@dataclass(frozen=True)
+class ShippedDefault:
+    """The shipped default of plain ``fuzzy-rrt``, both rulebooks loaded once (``two_joint``,
+    ``any_arm``), for callers that plan many problems (bench, evaluate): pass it as
+    ``plan_scenario(..., rulebook=...)`` and each problem gets :func:`shipped_default`'s choice
+    without re-reading a rulebook inside the timed call. ``rulebook=None`` means the same."""
+
+    two_joint: Any
+    any_arm: Any
+
+    def for_scenario(self, scenario: Scenario) -> tuple[str, Any]:
+        """``(planner, loaded rulebook)`` of :func:`shipped_default` for *scenario*."""
+        if is_two_joint_problem(scenario):
+            return "fuzzy-rrt", self.two_joint
+        return ANY_ARM_PLANNER, self.any_arm
+
+
+def load_shipped_default() -> ShippedDefault:
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+
+    return ShippedDefault(load_rulebook(default_rulebook_dir("fuzzy-rrt")),
+                          load_rulebook(default_rulebook_dir(ANY_ARM_PLANNER)))
 
 
 def shipped_rulebook_names() -> list[str]:
@@ -130,7 +186,12 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     """Plan ``scenario`` with the named planner (a label :func:`parse_planner` accepts).
 
     ``rulebook`` (fuzzy-rrt and fuzzy-rrt-connect) is a loaded rulebook, a directory path, or
-    ``None`` for the planner's shipped default, or for the one a ``...:NAME`` label names.
+    ``None`` (or a :class:`ShippedDefault`) for the planner's shipped default, or for the one a
+    ``...:NAME`` label names. Plain ``fuzzy-rrt`` without a rulebook follows
+    :func:`shipped_default`: on a problem that is not one 2-joint arm it runs
+    ``fuzzy-rrt-connect`` with ``goal-frame-any``; the result's ``planner`` stays the label
+    (``fuzzy-rrt``) and ``planner_used`` says what ran, ``rulebook``/``rulebook_sha256`` which
+    rulebook.
     ``step_deg``/``goal_bias`` configure plain RRT; ``goal_bias`` also the OMPL planners that
     have one. Fuzzy-RRT takes both from its rulebook. ``ompl:NAME[:sampled][:range=DEG]`` runs
     OMPL's geometric planner NAME with our collision checker and, unless ``:sampled``, our
@@ -155,23 +216,37 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
             tuned = _tuned_rrt("--planner")
             result = plan_rrt(scenario, seed=seed, max_iter=max_iter, clearance_m=clearance_m,
                               max_time_s=max_time_s, **tuned)
-            return replace_result(result, planner=RRT_TUNED,
+            return replace_result(result, planner=RRT_TUNED, planner_used=RRT_TUNED,
                                   params={**result.params, "tuned": True})
         return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
                         goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
     if spec.kind in RULEBOOK_KINDS:
+        kind = spec.kind
+        default = rulebook if isinstance(rulebook, ShippedDefault) else None
+        if default is not None:  # the shipped default, preloaded: the same as rulebook=None
+            rulebook = None
         if spec.rulebook_dir is not None:
             if rulebook is not None and not _same_rulebook(rulebook, spec.rulebook_dir):
                 raise InputError("--rulebook", f"conflicts with --planner {spec.label} (which "
                                  "names its own rulebook); give only one")
             rulebook = rulebook if rulebook is not None else spec.rulebook_dir
-        if spec.kind == "fuzzy-rrt-connect":
+        elif rulebook is None and kind == "fuzzy-rrt":
+            # No rulebook named: the shipped default, per problem (shipped_default's rule).
+            if default is not None:
+                kind, rulebook = default.for_scenario(scenario)
+            else:
+                # rulebook None: that planner's own default (the rule without its ~0.1 ms
+                # rulebook-directory look-up, which the planner does anyway)
+                kind = "fuzzy-rrt" if is_two_joint_problem(scenario) else ANY_ARM_PLANNER
+        elif rulebook is None and default is not None:
+            rulebook = default.any_arm
+        if kind == "fuzzy-rrt-connect":
             from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect as plan_fuzzy
         else:
             from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt as plan_fuzzy
         result = plan_fuzzy(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
                             trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
-        return replace_result(result, planner=spec.label)
+        return replace_result(result, planner=spec.label, planner_used=kind)
     from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 
     # OMPL's range comes from the label (ompl:NAME:range=DEG) or the tuned file, not step_deg.

@@ -102,9 +102,15 @@ def check_rulebook_fits(rb, scenario: Scenario) -> None:
 
     Paper semantics reads one arm at a time, so its DOF is each arm's; goal-frame reads the
     joint space of all arms together, so its DOF is the total.
+
+    Only a rulebook the user named gets here with a mismatch: without one, plain ``fuzzy-rrt``
+    plans a problem that is not one 2-joint arm with Fuzzy-RRT-Connect and ``goal-frame-any``
+    (:func:`xfuzzy_rrt.planners.api.shipped_default`), so the error says so.
     """
     dof = int(getattr(rb, "dof", 2))
     where = scenario.source or scenario.name
+    default = ("; or name no rulebook: the default plans any arm with fuzzy-rrt-connect and "
+               "goal-frame-any")
     if rb.semantics.dof_free:
         raise InputError(where, f"rulebook {rb.name!r} has the {rb.semantics.name} semantics, "
                          "which plans with --planner fuzzy-rrt-connect (fuzzy-rrt takes paper "
@@ -113,13 +119,14 @@ def check_rulebook_fits(rb, scenario: Scenario) -> None:
         if dof != scenario.dof:
             raise InputError(where, f"rulebook {rb.name!r} is a {dof}-DOF goal-frame rulebook; "
                              f"this problem has {scenario.dof} joints in all (train or pick a "
-                             f"{scenario.dof}-DOF rulebook)")
+                             f"{scenario.dof}-DOF rulebook{default})")
         return
     for a, arm in enumerate(scenario.arms):
         if arm.dof != dof:
             which = "the arm" if len(scenario.arms) == 1 else f"arm {a + 1}"
             raise InputError(where, f"rulebook {rb.name!r} is a {dof}-DOF rulebook; {which} "
-                             f"has {arm.dof} joints (train or pick a {arm.dof}-DOF rulebook)")
+                             f"has {arm.dof} joints (train or pick a {arm.dof}-DOF "
+                             f"rulebook{default})")
 
 
 @nb.njit(cache=True, nogil=True, inline="always")

@@ -95,7 +95,10 @@ def _replay_result(path: Path, rulebook: Path | None):
         data = json.loads(path.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise InputError(str(path), f"not a JSON plan result: {exc}") from None
-    if not isinstance(data, dict) or data.get("planner") not in ("fuzzy-rrt", "fuzzy-rrt-connect"):
+    # planner_used: what ran (plain fuzzy-rrt plans a problem that is not one 2-joint arm with
+    # fuzzy-rrt-connect and goal-frame-any; planners/api.py:shipped_default)
+    used = (data.get("planner_used") or data.get("planner")) if isinstance(data, dict) else None
+    if used not in ("fuzzy-rrt", "fuzzy-rrt-connect"):
         raise InputError(str(path), "planner: only fuzzy-rrt and fuzzy-rrt-connect results can "
                          "be explained")
     for key in ("scenario_file", "rulebook_dir", "rulebook_sha256", "seed"):
@@ -122,7 +125,7 @@ def _replay_result(path: Path, rulebook: Path | None):
                              "--rulebook DIR")
     max_iter = int(data.get("params", {}).get("max_iter", 10_000))
     plan = plan_fuzzy_rrt
-    if data["planner"] == "fuzzy-rrt-connect":
+    if used == "fuzzy-rrt-connect":
         from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect as plan
     result = plan(scenario, rb, seed=int(data["seed"]), max_iter=max_iter, trace=True)
     if result.iterations != data.get("iterations"):

@@ -129,6 +129,10 @@ class PlanResult:
     #: edge check; 0 without a path): ``work + certify_work`` is the end-to-end work, the
     #: deterministic stand-in for the time a user waits (the tuner's objective).
     certify_work: int = 0
+    #: The planner that actually ran, as ``--planner`` names it without a rulebook
+    #: (``fuzzy-rrt-connect`` when plain ``fuzzy-rrt`` planned a problem that is not one 2-joint
+    #: arm with its shipped default; ``fuzzy-rrt`` for ``fuzzy-rrt:NAME``); ``None``: ``planner``.
+    planner_used: str | None = None
 
     def __post_init__(self) -> None:
         if self.certified and not self.found:
@@ -151,6 +155,7 @@ class PlanResult:
         return {
             "scenario": self.scenario,
             "planner": self.planner,
+            "planner_used": self.planner_used or self.planner,
             "rulebook": self.rulebook,
             "rulebook_sha256": self.rulebook_sha256,
             "seed": int(self.seed),

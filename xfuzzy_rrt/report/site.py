@@ -379,7 +379,7 @@ def _certification(ctx, page: Page, t: pd.DataFrame) -> None:
         link = Names.from_entry(ctx["names"].scen[r.scenario]) \
             if r.scenario in ctx["names"].scen else None
         more = (f'<p class="muted"><a href="{esc(link)}">scenario {esc(r.scenario)}</a> '
-                f'\u00b7 reproduce: <code>{esc(_plan_cmd(ctx, s, p, r.seed))}</code></p>'
+                f'\u00b7 reproduce: <code>{esc(_plan_cmd(ctx, s, p, r.seed, r))}</code></p>'
                 if link else "")
         cells.append(f'<div class="cell">{page.figure(fig, f"fig-worst-{slug(p)}")}{more}</div>')
     page.add('<div class="grid" style="grid-template-columns: repeat(auto-fill, '
@@ -490,7 +490,7 @@ def _exists_beside(ctx, name: str) -> bool:
 # Scenario pages
 # ----------------------------------------------------------------------------------------------
 
-def _plan_cmd(ctx, s, planner: str, seed: int) -> str:
+def _plan_cmd(ctx, s, planner: str, seed: int, run=None) -> str:
     src = getattr(s, "source", "") or f"{s.name}.toml"
     plan_planner = "fuzzy-rrt" if planner.startswith("fuzzy-rrt") else planner
     cmd = (f"xfuzzy-rrt plan {shlex.quote(src)} --planner {shlex.quote(plan_planner)} "
@@ -498,9 +498,27 @@ def _plan_cmd(ctx, s, planner: str, seed: int) -> str:
     if ctx["settings"].get("max_iter") is not None:
         cmd += f" --max-iter {int(ctx['settings']['max_iter'])}"
     d = rulebook_dir(planner, ctx["result"]) if plan_planner == "fuzzy-rrt" else None
-    if d:
+    if d and not _ran_any_arm_default(planner, run):
         cmd += f" --rulebook {shlex.quote(str(d))}"
     return cmd
+
+
+def _ran_any_arm_default(planner: str, run) -> bool:
+    """A run of plain ``fuzzy-rrt`` that its shipped default planned with Fuzzy-RRT-Connect
+    (a problem that is not one 2-joint arm): ``plan --planner fuzzy-rrt`` without
+    ``--rulebook`` reproduces it, and the 2-joint rulebook would be refused there."""
+    return planner == "fuzzy-rrt" and getattr(run, "planner_used", None) == "fuzzy-rrt-connect"
+
+
+def _book_of_run(ctx, planner: str, run):
+    """The rulebook that made ``run``: its planner's, else the benchmark's rulebook with the
+    run's SHA-256 (plain ``fuzzy-rrt`` runs ``goal-frame-any`` on problems that are not one
+    2-joint arm; the benchmark lists it under ``fuzzy-rrt (any arm)``)."""
+    rb = ctx["books"].get(planner)
+    sha = getattr(run, "rulebook_sha256", None)
+    if rb is None or rb.sha256 == sha:
+        return rb
+    return next((b for b in ctx["books"].values() if b.sha256 == sha), rb)
 
 
 def _scenario_page(ctx, idx: int, name: str) -> str:
@@ -550,7 +568,7 @@ def _scenario_page(ctx, idx: int, name: str) -> str:
             fig = (F.joint_space_figure(s, r, grid=grid) if kind == "joint"
                    else F.workspace_figure(s, r))
             fig.update_layout(height=500, legend=dict(y=-0.2))
-            extra = (_reproduce(_plan_cmd(ctx, s, p, r.seed)) if kind == "workspace" else "")
+            extra = (_reproduce(_plan_cmd(ctx, s, p, r.seed, r)) if kind == "workspace" else "")
             cells.append(f'<div class="cell">{page.figure(fig, f"fig-{slug(p)}-{kind}")}'
                          f"{extra}</div>")
         page.add(f'<div class="grid" style="grid-template-columns: repeat({ncol}, '
@@ -566,8 +584,8 @@ def _scenario_page(ctx, idx: int, name: str) -> str:
     n_drill = max(1, len(order))
     any_drill = False
     for k, p in enumerate(planners):
-        rb = ctx["books"].get(p)
         r = examples.get(p)
+        rb = _book_of_run(ctx, p, r)
         if rb is None or r is None or not _followable(r, rb):
             continue
         from xfuzzy_rrt.report.evidence import _follow_one_plan, _influence_table
@@ -575,7 +593,8 @@ def _scenario_page(ctx, idx: int, name: str) -> str:
         page.heading(f"Follow one plan: {F.planner_label(p)}", anchor=f"follow-{slug(p)}")
         page.add(_influence_table(r, rb))
         settings = dict(ctx["settings"])
-        settings["rulebook_dir"] = rulebook_dir(p, result)
+        settings["rulebook_dir"] = (None if _ran_any_arm_default(p, r)
+                                    else rulebook_dir(p, result))
         _follow_one_plan(page, f"{k}", s, r, rb, grid, settings, n_drill)
         any_drill = True
     if any_drill:
@@ -653,8 +672,11 @@ def _rulebook_page(ctx, planner: str, rb) -> str:
     page.add(page.figure(fig, "fig-surfaces"))
     page.add(_reproduce(f"xfuzzy-rrt rules show {shlex.quote(str(d or rb.name))}"))
     page.heading("Rule coverage in this benchmark's example runs", anchor="coverage")
+    from xfuzzy_rrt.planners.api import ANY_ARM_KEY
+
+    ran = ("fuzzy-rrt",) if planner == ANY_ARM_KEY else (planner,)  # its runs' label
     traces = [r.trace for (_, p), r in result.examples.items()
-              if p == planner and _followable(r, rb)]
+              if p in ran and _followable(r, rb)]
     cov = coverage_figure(traces, rb)
     if cov is None:
         page.paragraph("No trace of this rulebook is stored in the bench folder.")

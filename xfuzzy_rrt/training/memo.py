@@ -11,8 +11,10 @@ rejected. Both are pure functions of values the loop already has:
 - the fuzzy outputs an iteration uses (goal bias, the clipped sampling box, the step) depend
   only on the node ``q = T.nodes[current]`` (its end effector, nearest obstacle, the goal, the
   rulebook); they are computed once per node and read back afterwards;
-- :func:`~xfuzzy_rrt.planners.tree.nearest` of the goal depends only on the tree, so it is
-  reused while no node was added;
+- :func:`~xfuzzy_rrt.planners.tree.nearest` of the goal depends only on the tree, and a tree
+  only grows: the goal's nearest node is kept up to date as each node joins (the new node
+  wins only when strictly nearer, by the same distance arithmetic, so ties still go to the
+  lowest index) instead of being searched for on every goal sample;
 - :func:`~xfuzzy_rrt.planners.extend.extend` from node ``n`` towards the goal with step ``s``
   that added nothing will add nothing again (it reads only ``n``, the goal, ``s`` and the
   problem), so its outcome is reused for the same ``(n, s)``.
@@ -38,7 +40,7 @@ from xfuzzy_rrt.planners.extend import extend
 from xfuzzy_rrt.planners.fuzzy_rrt import BOUNDS_RELATIVE, _interval
 from xfuzzy_rrt.planners.result import ACCEPTED, GOAL_REACHED
 from xfuzzy_rrt.planners.rng import seed_state, uniform
-from xfuzzy_rrt.planners.tree import add_node, nearest, reset_tree
+from xfuzzy_rrt.planners.tree import _d2, add_node, nearest, reset_tree
 
 #: Columns of the per-node memo before the box: goal bias, step.
 _BIAS, _STEP, _BOX = 0, 1, 2
@@ -76,8 +78,8 @@ def paper_run(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, memo, 
 
     add_node(T, P.start, -1)
     current = 0
-    goal_near = -1  # nearest(T, goal) while the tree holds goal_near_count nodes
-    goal_near_count = -1
+    goal_near = 0  # nearest(T, goal), kept up to date as nodes join
+    goal_d2 = _d2(T.nodes, 0, P.goal)
     for it in range(1, max_iter + 1):
         if seen[current] != stamp:
             # 1-3: the fuzzy outputs at this node (fuzzy_rrt_kernel's arithmetic, in its order)
@@ -119,28 +121,31 @@ def paper_run(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, memo, 
         step = memo[current, _STEP]
         # 4. Sample (the same draws in the same order).
         if uniform(state) < bias:
-            n_nodes = T.meta[0]
-            if goal_near_count != n_nodes:
-                goal_near = nearest(T, P.goal)
-                goal_near_count = n_nodes
             current = goal_near
             if goal_outcome[current] // 8 == stamp and goal_step[current] == step:
                 continue  # this extension was tried and added nothing: it adds nothing now
-            outcome, _ = extend(P, T, current, P.goal, step, q_near, q_new)
+            outcome, k = extend(P, T, current, P.goal, step, q_near, q_new)
             if outcome == GOAL_REACHED:
                 return True, it
             if outcome != ACCEPTED:
                 goal_step[current] = step
                 goal_outcome[current] = stamp * 8 + outcome
-            continue
-        for j in range(dof):
-            lo = memo[current, _BOX + 2 * j]
-            sample[j] = lo + uniform(state) * (memo[current, _BOX + 2 * j + 1] - lo)
-        # 5-7. Nearest node (carried to the next iteration), steer, certify, grow.
-        current = nearest(T, sample)
-        outcome, _ = extend(P, T, current, sample, step, q_near, q_new)
-        if outcome == GOAL_REACHED:
-            return True, it
+        else:
+            for j in range(dof):
+                lo = memo[current, _BOX + 2 * j]
+                sample[j] = lo + uniform(state) * (memo[current, _BOX + 2 * j + 1] - lo)
+            # 5-7. Nearest node (carried to the next iteration), steer, certify, grow.
+            current = nearest(T, sample)
+            outcome, k = extend(P, T, current, sample, step, q_near, q_new)
+            if outcome == GOAL_REACHED:
+                return True, it
+        if outcome == ACCEPTED:
+            # node k joined: the goal's nearest node changes only if k is strictly nearer
+            # (ties keep the lower index, as nearest() does), by nearest()'s own distance
+            d2 = _d2(T.nodes, k, P.goal)
+            if d2 < goal_d2:
+                goal_near = k
+                goal_d2 = d2
     return False, max_iter
 
 

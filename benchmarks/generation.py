@@ -10,7 +10,9 @@ printed too):
   the CPU microseconds per iteration — no engine can beat it without a faster kernel;
 - one generation through the trainer's evaluator (warm: the workers are started and their
   kernels loaded by a first small call), wall seconds and the CPU the workers spent, so the
-  difference shows what process hand-over and imbalance cost against planning itself.
+  difference shows what process hand-over and imbalance cost against planning itself;
+- breeding the next generation from this one (pymoo's operators, in the main process while
+  the workers wait): the rest of a generation's time.
 
 The population is the benchmark's (benchmarks/test_bench_training.py): half drawn like the
 GA's first generation, half near the shipped ``paper`` rulebook, as late in training.
@@ -103,6 +105,11 @@ def main(argv=None) -> int:
             walls.append(time.perf_counter() - t0)
             cpus.append((_cpu_of(pids) if pids else float("nan")) - c0)
             assert np.array_equal(got, its)
+    from xfuzzy_rrt.training.evaluate import fitness
+    from xfuzzy_rrt.training.ga import breed
+
+    fit = fitness(its, 10_000)
+    _, breed_wall, breed_cpu = _timed(lambda: breed(pop, fit, config, np.random.default_rng(0)))
     load1 = os.getloadavg()
     done = np.where(its < 0, 10_000, its)
     n_it = int(done.sum())
@@ -118,6 +125,8 @@ def main(argv=None) -> int:
     print(f"one generation, {args.workers} workers: median {statistics.median(walls):.3f} s wall "
           f"(rounds: {', '.join(f'{w:.3f}' for w in walls)}); worker CPU median "
           f"{statistics.median(cpus):.3f} s")
+    print(f"breeding the next generation (main process, serial): {breed_wall:.3f} s wall, "
+          f"{breed_cpu:.3f} s CPU")
     return 0
 
 

@@ -103,7 +103,7 @@ def iterations_for(problems: list[TrainingProblem], knots_b: np.ndarray, consts_
     This is the unit of work a worker process or Dask task runs; the result depends only on its
     arguments, so splitting a population into chunks never changes any number. The paper's
     semantics runs through :func:`~.memo.paper_population` (the planner's loop with its pure
-    per-node work remembered: the same numbers, about a fifth less time), the goal-frame one
+    per-node work remembered: the same numbers, about 30 % less CPU), the goal-frame one
     through :func:`run_population` (the planner's own kernel).
     """
     mode = {"relative": BOUNDS_RELATIVE, "goal-frame": GOAL_FRAME}.get(bounds_mode, BOUNDS_ABSOLUTE)

@@ -2,7 +2,8 @@
 
 Modules: :mod:`.genome` (3,822 genes <-> six always-valid fuzzy systems), :mod:`.evaluate`
 (compiled runs of a whole population: genes go straight to the planner kernel's arrays, no
-text, no DataFrames, no Python per iteration), :mod:`.workers` (in-process, local processes or
+text, no DataFrames, no Python per iteration), :mod:`.memo` (the paper-semantics loop that
+remembers per-node work within a run: the planner's exact iterations, less work), :mod:`.workers` (in-process, local processes or
 Dask — same numbers from each), :mod:`.ga` (the generational loop), :mod:`.checkpoint`
 (atomic, self-checking state files) and :mod:`.run` (a whole job: outputs and provenance).
 

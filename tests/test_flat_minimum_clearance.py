@@ -134,11 +134,12 @@ def test_curvature_bound_holds_for_a_link_tip_turning_past_an_obstacle(far, ro):
     assert true_min - lb < 0.02 * (c_end - true_min)
 
 
-@pytest.mark.parametrize("gap", [2e-3, 1e-2])
-def test_curvature_bound_holds_for_a_folded_tip_turning_past_its_own_arm(gap):
+@pytest.mark.parametrize("gap, radius", [(2e-3, 1e-4), (1e-2, 1e-4), (2e-3, 5e-4)])
+def test_curvature_bound_holds_for_a_folded_tip_turning_past_its_own_arm(gap, radius):
     # three links: link 2 folded back over link 1, its tip passing `gap` from the joint
-    # between links 0 and 1 while joint 2 turns: self pair (0, 2), only joint 2 moves it
-    l0, l1, radius = 0.2, 0.1, 1e-4
+    # between links 0 and 1 while joint 2 turns: self pair (0, 2), only joint 2 moves it; with
+    # thick capsules the radii are half the gap, so the distance D must add exactly them
+    l0, l1 = 0.2, 0.1
     links = np.array([l0, l1, l1 - gap])
     P = arms_problem([(links, (0.0, 0.0), radius)], limits=np.tile([-360.0, 360.0], (3, 1)))
     qa, qb = _turning_past([0.0, 0.0, 180.0], 2, gap, links[2])

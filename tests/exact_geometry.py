@@ -270,6 +270,20 @@ class Oracle:
 #   ``upper`` is an exact clearance at a real configuration on the segment (``q_at_upper``), and,
 #   unless the evaluation budget ran out (``exhausted``), ``upper - lower <= tol``.
 #
+#   Curvature (what closes *flat* minima: two links of a straight arm stay exactly one link
+#   apart while a joint between them turns, so the clearance is constant over a whole segment
+#   and the Lipschitz bound alone needs ``L / tol`` intervals). The points above move along
+#   sums of ``l_h e(ψ_h)`` with every ``ψ_h`` linear in ``s``, so the vector ``u`` between a
+#   point of one body and a point of the other has ``|u'| <= L_p`` and
+#   ``|u''| <= A_p := Σ l_h (Σ Δq)²`` (the same sums as the speeds, the rates squared; for two
+#   arms the two links' sums added). While ``|u| >= D > 0``,
+#   ``|u|'' = (|u'|² - (u·u'/|u|)²) / |u| + u·u''/|u| <= L_p² / D + A_p =: K_p``, and a pair's
+#   clearance is a minimum of such ``|u|`` over the two bodies' points (minus constants), so on
+#   ``[s0, s1]`` it stays above its chord minus ``K_p/2 (s - s0)(s1 - s)``. ``D`` is the
+#   Lipschitz bound itself plus the capsule radii (``-floor``; a circle's radius is left out,
+#   which only lowers ``D``); where that is not positive only the Lipschitz bound is used. The
+#   lowest point of that parabola on the interval is the second bound; a pair keeps the larger.
+#
 # **Tolerance.** Float64 rounding: coordinates are sums of at most 7 products of magnitude
 # ``S`` (the scene's extent), so every computed distance is within ``FP_REL * max(S, 1)`` metres
 # of the exact one, ``FP_REL = 1e-12`` (a generous multiple of the ~1e-15 accumulated error).
@@ -501,6 +515,27 @@ class World:
             out.append(np.array([self.self_pair_speed(links, local, i, j) for i, j in pairs]))
         return np.concatenate(out) if out else np.zeros(0)
 
+    def pair_accel(self, qa_deg, qb_deg) -> np.ndarray:
+        """``[P]`` bound on the relative acceleration (m per unit ``s``²) of the two closest
+        points of every pair on ``qa -> qb`` (module notes: the speeds' sums, rates squared)."""
+        dq = np.radians(np.asarray(qb_deg, dtype=float) - np.asarray(qa_deg, dtype=float))
+        acc = [np.cumsum(links * np.cumsum(dq[self.first[a]:self.first[a + 1]]) ** 2)
+               for a, (links, _, _) in enumerate(self.arms)]
+        out = []
+        for a in range(len(self.arms)):
+            out.append(np.repeat(acc[a], len(self.circles)))
+            out.append(np.repeat(acc[a], len(self.boxes)))
+        for a in range(len(self.arms)):
+            for b in range(a + 1, len(self.arms)):
+                out.append((acc[a][:, None] + acc[b][None, :]).ravel())
+        for a, pairs in enumerate(self._self):
+            links = self.arms[a][0]
+            local = dq[self.first[a]:self.first[a + 1]]
+            out.append(np.array([float(np.sum(links[i + 1:j + 1] *
+                                              np.cumsum(local[i + 1:j + 1]) ** 2))
+                                 for i, j in pairs]))
+        return np.concatenate(out) if out else np.zeros(0)
+
     @staticmethod
     def self_pair_speed(links, dq_rad, i, j) -> float:
         """``W_ij = Σ_{i<h<=j} l_h |Σ_{i<g<=h} Δq_g|`` (module notes): how fast link ``j``
@@ -555,6 +590,7 @@ class World:
         if self.n_pairs == 0:
             return Bracket(math.inf, math.inf, qa, False)
         lip = self.pair_lipschitz(qa, qb)
+        acc = self.pair_accel(qa, qb)[None, :]
         floor = self.pair_floors()[None, :]
         if not np.any(qb != qa):
             c = float(self.pair_clearances(qa)[0].min())
@@ -571,7 +607,9 @@ class World:
         exhausted = False
         while s0.size:
             h = s1 - s0
-            low = np.min(np.maximum((f0 + f1 - lip[None, :] * h[:, None]) * 0.5, floor), axis=1)
+            low1 = np.maximum((f0 + f1 - lip[None, :] * h[:, None]) * 0.5, floor)
+            low = np.min(np.maximum(low1, _curvature_bound(f0, f1, lip[None, :], acc, low1 - floor,
+                                                           h[:, None])), axis=1)
             low = np.minimum(low, np.minimum(f0.min(axis=1), f1.min(axis=1)))
             done = low >= upper - tol
             if threshold is not None:
@@ -620,6 +658,19 @@ class World:
             if threshold is not None and best.upper <= threshold:
                 break
         return best
+
+
+def _curvature_bound(f0, f1, lip, acc, dist, h):
+    """Per pair, the lowest point of ``chord - K/2 (s - s0)(s1 - s)`` on intervals of width
+    ``h`` (module notes), ``K = acc + lip² / dist``; ``-inf`` where ``dist`` (a lower bound on
+    the bodies' distance) is not positive or a value is not finite."""
+    ok = (dist > 0.0) & np.isfinite(f0) & np.isfinite(f1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = 0.5 * (acc + lip * lip / np.where(ok, dist, 1.0)) * h * h
+        d = f1 - f0
+        inner = 0.5 * (f0 + f1) - 0.25 * a - d * d / (4.0 * a)
+        out = np.where(np.abs(d) >= a, np.minimum(f0, f1), inner)
+    return np.where(ok, out, -np.inf)
 
 
 @dataclass(frozen=True)

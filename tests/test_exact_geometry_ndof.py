@@ -296,7 +296,9 @@ def test_agrees_with_the_2dof_shapely_oracle(path):
         if not math.isfinite(best):
             assert lo == hi == math.inf
             continue
-        assert lo <= best + 1e-15 and hi <= best + 1e-15
+        # proven below every sample; exact at a real configuration within the bracket's
+        # tolerance of the true minimum, hence of the sampled one
+        assert lo <= best + 1e-15 and hi <= best + 1e-8
         assert old_lower <= hi + 1e-12
         # Where the new oracle proves a path free, the old sampled check finds nothing; where
         # the old one samples a real collision, the new one never calls the path free.

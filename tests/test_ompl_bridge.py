@@ -372,8 +372,8 @@ def test_cli_plan_with_an_ompl_planner_repeats_across_processes(run_cli):
         assert proc.returncode == 1, proc.stderr
         assert proc.stderr == (f"not certified: {TWO_CIRCLES}: ompl:RRTConnect:sampled:range=10 seed 4: "
                                "segment "
-                               "38 penetrates an obstacle 0.03163 mm deep at q = (129.996, "
-                               "-96.6686) deg\n")
+                               "38 penetrates an obstacle 0.03163 mm deep at q = (129.994, "
+                               "-96.6681) deg\n")
         data = json.loads(proc.stdout)
         assert (data["found"], data["certified"], data["success"]) == (True, False, False)
         assert data["min_clearance_m"] == pytest.approx(-3.163e-5, abs=1e-8)

@@ -24,16 +24,16 @@ exact for two convex polygons in the plane (separating axis theorem). Outside, i
 ordinary exact distance, so the two checks agree on every free configuration.
 
 ``min_clearance_m`` is the smallest of these signed clearances over the whole path (negative:
-the exact penetration depth), found by Lipschitz branch and bound instead of a scan. Along a
-segment the signed clearance ``c(s)`` changes by at most ``M`` per unit ``s`` (``M = max_k
-M_k``, the motion bound of the certified check in ``collision.py``: no point of any link moves farther, and a signed distance to a convex obstacle
-moves no more than the segment does), so on an interval ``[s0, s1]`` with end values
-``c0, c1`` nothing is smaller than ``(c0 + c1 - M (s1 - s0)) / 2``. Intervals whose bound
-cannot beat the best value seen by more than ``MIN_CLEARANCE_TOL_M`` (0.1 um) are dropped,
-the others are halved (per link, with that link's own bound ``M_k``, which is tighter). The
-search itself is :func:`xfuzzy_rrt.geometry.clearance.min_clearance_kernel` (one
-implementation, shared with the robustness Monte Carlo). The value returned is an exact distance at a real configuration on the path (``min_config_deg``),
-and no configuration on the path is closer by more than 0.1 um.
+the exact penetration depth), found by branch and bound instead of a scan:
+:func:`xfuzzy_rrt.geometry.clearance.min_clearance_kernel` (one implementation, shared with the
+robustness Monte Carlo). Per element (a link against the obstacles, a link pair) and interval
+``[s0, s1]`` of a segment it bounds the clearance from below twice -- by its speed
+(``(c0 + c1 - V (s1 - s0)) / 2``, the motion bound of the certified check, summed after the
+joint rates) and by its curvature (the chord minus ``K/2 (s - s0)(s1 - s)``, which is what
+proves flat minima such as two links of a straight arm held one link apart) -- and drops the
+intervals that cannot beat the best value seen by more than ``MIN_CLEARANCE_TOL_M`` (0.1 um).
+The value returned is an exact distance at a real configuration on the path
+(``min_config_deg``), and no configuration on the path is closer by more than 0.1 um.
 ``penetration_m`` is ``max(0, -min_clearance_m)``.
 """
 
@@ -59,9 +59,10 @@ from xfuzzy_rrt.geometry.signed import (  # noqa: F401
     signed_segment_obstacle_dist,
 )
 
-#: Distance evaluations per path after which the branch and bound stops refining and reports
-#: its proven lower bound instead (only reached when the clearance stays within the tolerance of its
-#: minimum over a long stretch, e.g. a link turning about the centre of a circle).
+#: Configurations evaluated per path after which the branch and bound stops refining and
+#: reports its proven lower bound instead (a safety net: flat minima, a link turning about the
+#: centre of a circle or two links of a straight arm held one link apart, close in thousands
+#: with the curvature bound).
 MIN_CLEARANCE_MAX_EVALS = 2_000_000
 
 
@@ -163,11 +164,12 @@ def path_min_clearance(arrays, path_deg, margin: float = CERT_MARGIN_M) -> tuple
     path = np.ascontiguousarray(np.asarray(path_deg, dtype=np.float64))
     problem = arrays.problem(margin)
     value, _seg, _s = _min_clearance(problem, path)
-    # Only certified paths are measured here (planners/result.py), and certification already
-    # proved that no configuration on them comes closer than the surgeon's clearance
-    # (geometry/collision.py). When the branch and bound runs out of budget -- a flat minimum,
-    # e.g. two non-adjacent links of a straight arm exactly one link apart over a whole
-    # segment -- its proven bound can be far looser than that; it never goes below it.
+    # Only certified paths are measured here (planners/result.py), and certification proved
+    # that no configuration on them comes closer than the surgeon's clearance
+    # (geometry/collision.py). The branch and bound proves its value to 0.1 um, flat minima
+    # included, so this changes nothing unless its evaluation budget runs out (no known path
+    # does): then ``value`` is its proven lower bound, and the larger of two proven lower
+    # bounds is still one -- a true statement, never an optimistic one.
     value = max(value, float(problem.clearance))
     return value, (max(0.0, -value) if math.isfinite(value) else 0.0)
 

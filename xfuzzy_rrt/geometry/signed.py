@@ -6,11 +6,13 @@ is, needs a distance that keeps decreasing inside: here it is the exact minimum 
 distance (separating axis theorem) between a link segment and a convex obstacle, or between
 two link segments of different arms. Outside, every function agrees with the unsigned one.
 
-``element_clearances`` is the view the Lipschitz branch and bound of ``clearance.py`` works on:
-one signed clearance per *element* -- each link against the obstacles, then each pair of links
-of different arms, then each pair of non-adjacent links of one arm (self-collision) -- with
-``element_motion_bounds`` the matching Lipschitz constants (``M_k``, ``M_k + M_m``, and
-``collision.self_pair_motion_bound`` for a self pair).
+``element_clearances`` is the view the branch and bound of ``clearance.py`` works on: one
+signed clearance per *element* -- each link against the obstacles, then each pair of links of
+different arms, then each pair of non-adjacent links of one arm (self-collision) -- with
+``element_motion_bounds`` the matching Lipschitz constants of the certified check (``M_k``,
+``M_k + M_m``, and ``collision.self_pair_motion_bound`` for a self pair); the branch and bound
+itself uses the tighter speed and the curvature constants of
+``clearance.element_speed_accel``.
 """
 
 from __future__ import annotations

@@ -386,6 +386,92 @@ def self_pair_motion_bound(links, qa_deg, qb_deg, k, m):
     return link_motion_bound(links, qa_deg, qb_deg, m, k + 1)
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def two_link_clearances(P, q0_deg, q1_deg):
+    """Clearance of each link of ONE two-link arm (``P`` has one arm of two links) at the joint
+    angles ``(q0_deg, q1_deg)``: :func:`clearance_kernel`'s per-link values, same arithmetic,
+    without counting work. ``clearance_kernel`` is ``min(min(inf, c0), c1)`` of them."""
+    x = P.bases[0, 0]
+    y = P.bases[0, 1]
+    nx, ny, theta = fk_step(x, y, 0.0, P.links[0], q0_deg)
+    c0 = _link_clearance(x, y, nx, ny, P.radii[0], P.obstacles)
+    mx, my, theta = fk_step(nx, ny, theta, P.links[1], q1_deg)
+    c1 = _link_clearance(nx, ny, mx, my, P.radii[0], P.obstacles)
+    return c0, c1
+
+
+@nb.njit(cache=True, nogil=True)
+def edge_free_two_link(P, qa_deg, qb_deg, margin, ca0, ca1, cb0, cb1):
+    """:func:`edge_free` for ONE arm of two links (the only single-arm case without self
+    pairs: every 2-DOF problem), given the per-link clearances at the ends when known.
+
+    ``(ca0, ca1)`` at ``qa`` and ``(cb0, cb1)`` at ``qb`` (:func:`two_link_clearances`; ``NaN``
+    in the first of a pair: not known, measured here). An edge's first stop is ``qa`` and its
+    last is ``qb``, both bit for bit (``qa + 0 * (qb - qa) == qa``, and the last stop takes
+    ``qb`` itself), so a planner that measured its nodes passes their values instead of having
+    them measured again. Same stops, same verdict, same ``P.work`` as :func:`edge_free` (every
+    stop counts, measured here or given), and no allocation.
+
+    Returns ``(free, c0, c1)``: the verdict and the per-link clearances at ``qa`` (as given,
+    or as measured at the first stop; ``NaN`` when the check ended before measuring them).
+    """
+    if P.obstacles.shape[0] == 0:
+        return True, ca0, ca1
+    clear = P.clearance
+    if margin < clear:
+        return False, ca0, ca1
+    m0 = link_motion_bound(P.links, qa_deg, qb_deg, 0, 0)
+    m1 = link_motion_bound(P.links, qa_deg, qb_deg, 1, 0)
+    per_stop = n_distance_pairs(P)
+    s = 0.0
+    first = True
+    while True:
+        P.work[0] += per_stop
+        if s >= 1.0 and cb0 == cb0:
+            c0 = cb0
+            c1 = cb1
+        elif first and ca0 == ca0:
+            c0 = ca0
+            c1 = ca1
+        else:
+            q0 = qa_deg[0] + s * (qb_deg[0] - qa_deg[0])
+            q1 = qa_deg[1] + s * (qb_deg[1] - qa_deg[1])
+            if s >= 1.0:
+                q0 = qb_deg[0]
+                q1 = qb_deg[1]
+            c0, c1 = two_link_clearances(P, q0, q1)
+            if first:
+                ca0 = c0
+                ca1 = c1
+        first = False
+        # edge_free's per-link checks, link 0 then link 1
+        if not c0 < np.inf:
+            return False, ca0, ca1
+        cmin = np.inf
+        ds = np.inf
+        if c0 < cmin:
+            cmin = c0
+        if m0 > 0.0:
+            step = (c0 - clear) / m0
+            if step < ds:
+                ds = step
+        if not c1 < np.inf:
+            return False, ca0, ca1
+        if c1 < cmin:
+            cmin = c1
+        if m1 > 0.0:
+            step = (c1 - clear) / m1
+            if step < ds:
+                ds = step
+        if cmin <= margin:
+            return False, ca0, ca1
+        if s >= 1.0:
+            return True, ca0, ca1
+        s += ds
+        if s > 1.0:
+            s = 1.0
+
+
 @nb.njit(cache=True, nogil=True)
 def edge_free(P, qa_deg, qb_deg, margin):
     """Certified check of the straight joint segment ``qa -> qb`` (conservative advancement).
@@ -400,6 +486,9 @@ def edge_free(P, qa_deg, qb_deg, margin):
     (an inconsistent call: the steps would go backwards) certifies nothing.
     """
     n_arms = P.arm_first.shape[0] - 1
+    if n_arms == 1 and P.links.shape[0] == 2:  # one two-link arm: no arrays needed
+        nan = np.nan
+        return edge_free_two_link(P, qa_deg, qb_deg, margin, nan, nan, nan, nan)[0]
     obstacles = P.obstacles
     has_obstacles = obstacles.shape[0] > 0
     has_self = has_self_pairs(P)

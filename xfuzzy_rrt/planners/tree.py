@@ -67,6 +67,13 @@ class TreeArrays(NamedTuple):
     #: each node's clearance (m) as measured when it was accepted (NaN where it was not:
     #: a goal joined by the connection step); planners read it instead of measuring again
     clear: np.ndarray
+    #: one two-link arm only (``[capacity + 1, 2]``; ``[1, 2]`` otherwise, unused): each node's
+    #: clearance per link, the values the certified edge check measures at an edge's ends, so
+    #: that an edge leaving or reaching a measured node does not measure it again
+    #: (:func:`xfuzzy_rrt.planners.extend.extend`). The last row holds the goal's. ``NaN`` in
+    #: column 0: not measured in this run (:func:`add_node` writes it for every new node, and
+    #: for the goal row when a run adds its root).
+    link_clear: np.ndarray
 
 
 #: ``meta`` slot holding how many nodes the k-d tree covers (the rest are in the buffer).
@@ -108,7 +115,8 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
         np.zeros(kd, dtype=np.int64), np.zeros(kd, dtype=np.int64),
         np.zeros((KD_STACK, 3), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64),
         np.zeros((KD_STACK + 1 if dof > 2 else 1, dof), dtype=np.float64),
-        np.empty(capacity, dtype=np.float64))
+        np.empty(capacity, dtype=np.float64),
+        np.full((capacity + 1 if dof == 2 else 1, 2), np.nan, dtype=np.float64))
 
 
 
@@ -395,6 +403,11 @@ def add_node(T, q, parent_index):
     T.meta[N_NODES] = i + 1
     dof = T.nodes.shape[1]
     if dof == 2:
+        # not measured yet (extend writes the values after adding a node it measured); a new
+        # run starts with its root, and its goal is not measured yet either
+        T.link_clear[i, 0] = np.nan
+        if i == 0:
+            T.link_clear[T.link_clear.shape[0] - 1, 0] = np.nan
         _grid_add(T.cell_next, T.cell_head, T.meta, T.grid, i, q[0], q[1])
     elif i + 1 > _brute_max(dof) and (i + 1 - T.meta[KD_N]) > max(32.0, 2.0 * math.sqrt(i + 1.0)):
         _kd_build(T, i + 1)

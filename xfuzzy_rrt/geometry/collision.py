@@ -203,13 +203,50 @@ def segment_obstacle_dist(ax, ay, bx, by, ob):
     return _obstacle_dist(ax, ay, bx, by, ob[0], ob[1], ob[2], ob[3], ob[4])
 
 
+#: Relative slack of the obstacle pre-filter in :func:`_link_clearance` (times 1 + the
+#: largest coordinate involved): a million times the rounding error of a distance.
+SKIP_SLACK = 1e-9
+
+
 @nb.njit(cache=True, nogil=True, inline="always")
 def _link_clearance(ax, ay, bx, by, radius, obstacles):
-    """Clearance of one link capsule (segment AB dilated by ``radius``) to all obstacles."""
+    """Clearance of one link capsule (segment AB dilated by ``radius``) to all obstacles.
+
+    An obstacle whose distance cannot be below the best so far is skipped, its distance not
+    computed: the gap between the segment's bounding box and the obstacle's (a circle's
+    centre, then its radius subtracted) is a lower bound of the exact distance, and the skip
+    needs it to beat the best by ``SKIP_SLACK`` x the coordinates' scale, far above the
+    rounding of a computed distance (and, for a box, of its crossing test): a skipped
+    obstacle's computed distance would not have replaced the best. So the value is the one of
+    computing every distance, bit for bit; only the time changes.
+    """
+    lox = min(ax, bx)
+    hix = max(ax, bx)
+    loy = min(ay, by)
+    hiy = max(ay, by)
+    seg_scale = max(abs(lox), abs(hix), abs(loy), abs(hiy))
     best = np.inf
     for o in range(obstacles.shape[0]):
-        d = _obstacle_dist(ax, ay, bx, by, obstacles[o, 0], obstacles[o, 1], obstacles[o, 2],
-                           obstacles[o, 3], obstacles[o, 4]) - radius
+        kind = obstacles[o, 0]
+        o1 = obstacles[o, 1]
+        o2 = obstacles[o, 2]
+        o3 = obstacles[o, 3]
+        o4 = obstacles[o, 4]
+        if best < np.inf:
+            if kind == 0.0:  # circle: centre (o1, o2), radius o3
+                gx = max(lox - o1, 0.0, o1 - hix)
+                gy = max(loy - o2, 0.0, o2 - hiy)
+                reach = best + radius + o3
+                scale = max(seg_scale, abs(o1), abs(o2), abs(o3))
+            else:  # box [o1, o3] x [o2, o4]
+                gx = max(o1 - hix, 0.0, lox - o3)
+                gy = max(o2 - hiy, 0.0, loy - o4)
+                reach = best + radius
+                scale = max(seg_scale, abs(o1), abs(o2), abs(o3), abs(o4))
+            reach += SKIP_SLACK * (1.0 + scale)
+            if reach > 0.0 and gx * gx + gy * gy > reach * reach:
+                continue
+        d = _obstacle_dist(ax, ay, bx, by, kind, o1, o2, o3, o4) - radius
         if d < best:
             best = d
     return best

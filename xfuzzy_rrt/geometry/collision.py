@@ -49,7 +49,10 @@ The user clearance is held between any two bodies alike.
 **Work.** ``P.work[0]`` counts exact element distances (one per link-obstacle pair, per link
 pair of two arms, per non-adjacent link pair of one arm) evaluated by :func:`clearance_kernel`
 and :func:`edge_free` (so :func:`config_free` too): a deterministic measure of planning work.
-It is only ever incremented, never read, by the kernels, so it cannot change a result.
+It is only ever incremented, never read, by the kernels, so it cannot change a result. It counts
+what the algorithm measures, not how: an edge stop whose values a planner already had (the
+node check's, :func:`edge_free_two_link`) and an obstacle skipped because it cannot be the
+nearest (:func:`_link_clearance`) count as before, so counts compare across versions.
 """
 
 from __future__ import annotations

@@ -341,14 +341,14 @@ def self_clearance(P, seg):
     return best
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def n_distance_pairs(P):
     """Exact element distances one configuration costs: links x obstacles, link pairs of two
     arms and non-adjacent link pairs of one arm (the unit of ``P.work``)."""
     return P.links.shape[0] * P.obstacles.shape[0] + n_link_pairs(P)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def n_link_pairs(P):
     """Link pairs that can touch: pairs of links of two arms, and non-adjacent links of one
     arm (shared by the work count and ``signed.n_elements``)."""
@@ -392,7 +392,7 @@ def clearance_kernel(P, q_deg):
     return best
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def within_limits(limits_deg, q_deg):
     for j in range(q_deg.shape[0]):
         if q_deg[j] < limits_deg[j, 0] or q_deg[j] > limits_deg[j, 1]:

@@ -32,7 +32,7 @@ from xfuzzy_rrt.planners.result import (
 from xfuzzy_rrt.planners.tree import add_node
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def extend(P, T, near, sample, step, q_near, q_new):
     """Extend tree ``T`` from node ``near`` towards ``sample`` in problem ``P``.
 
@@ -87,7 +87,7 @@ def extend(P, T, near, sample, step, q_near, q_new):
     return ACCEPTED, k
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def _extend_two_link(P, T, near, step, q_near, q_new):
     """:func:`extend` from the node check on, for one two-link arm (every 2-DOF problem).
 

@@ -49,7 +49,10 @@ The user clearance is held between any two bodies alike.
 **Work.** ``P.work[0]`` counts exact element distances (one per link-obstacle pair, per link
 pair of two arms, per non-adjacent link pair of one arm) evaluated by :func:`clearance_kernel`
 and :func:`edge_free` (so :func:`config_free` too): a deterministic measure of planning work.
-It is only ever incremented, never read, by the kernels, so it cannot change a result.
+It is only ever incremented, never read, by the kernels, so it cannot change a result. It counts
+what the algorithm measures, not how: an edge stop whose values a planner already had (the
+node check's, :func:`edge_free_two_link`) and an obstacle skipped because it cannot be the
+nearest (:func:`_link_clearance`) count as before, so counts compare across versions.
 """
 
 from __future__ import annotations
@@ -158,34 +161,95 @@ def _segment_hits_box(ax, ay, bx, by, x0, y0, x1, y1):
     return True
 
 
-@nb.njit(cache=True, nogil=True)
-def segment_obstacle_dist(ax, ay, bx, by, ob):
-    """Exact distance from segment AB to obstacle row ``ob`` (0 when they meet)."""
-    if ob[0] == 0.0:  # circle
-        d = _point_segment_dist(ob[1], ob[2], ax, ay, bx, by) - ob[3]
+@nb.njit(cache=True, nogil=True, inline="always")
+def _segment_offset2(px, py, ax, ay, bx, by):
+    """Squared distance from P to segment AB (``_point_segment_dist`` before its square root)."""
+    qx, qy = _segment_offset(px, py, ax, ay, bx, by)
+    return qx * qx + qy * qy
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _point_box_dist2(px, py, x0, y0, x1, y1):
+    """Squared ``_point_box_dist``."""
+    dx = max(x0 - px, 0.0, px - x1)
+    dy = max(y0 - py, 0.0, py - y1)
+    return dx * dx + dy * dy
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _obstacle_dist(ax, ay, bx, by, kind, o1, o2, o3, o4):
+    """:func:`segment_obstacle_dist` on an obstacle row's five numbers.
+
+    Why scalars: a row view per obstacle (``obstacles[o]``) cost a fifth of a clearance. For a
+    box, the six candidate distances are compared squared and one square root is taken:
+    ``sqrt`` is correctly rounded, hence monotonic, so ``sqrt(min(a, b)) == min(sqrt(a),
+    sqrt(b))`` bit for bit, the value of taking six roots.
+    """
+    if kind == 0.0:  # circle
+        d = _point_segment_dist(o1, o2, ax, ay, bx, by) - o3
         return d if d > 0.0 else 0.0
-    x0 = ob[1]
-    y0 = ob[2]
-    x1 = ob[3]
-    y1 = ob[4]
-    if _segment_hits_box(ax, ay, bx, by, x0, y0, x1, y1):
+    if _segment_hits_box(ax, ay, bx, by, o1, o2, o3, o4):
         return 0.0
     # Disjoint convex sets in the plane: the closest pair involves an endpoint of the segment
     # or a corner of the rectangle.
-    d = min(_point_box_dist(ax, ay, x0, y0, x1, y1), _point_box_dist(bx, by, x0, y0, x1, y1))
-    d = min(d, _point_segment_dist(x0, y0, ax, ay, bx, by))
-    d = min(d, _point_segment_dist(x1, y0, ax, ay, bx, by))
-    d = min(d, _point_segment_dist(x0, y1, ax, ay, bx, by))
-    d = min(d, _point_segment_dist(x1, y1, ax, ay, bx, by))
-    return d
+    d2 = min(_point_box_dist2(ax, ay, o1, o2, o3, o4), _point_box_dist2(bx, by, o1, o2, o3, o4))
+    d2 = min(d2, _segment_offset2(o1, o2, ax, ay, bx, by))
+    d2 = min(d2, _segment_offset2(o3, o2, ax, ay, bx, by))
+    d2 = min(d2, _segment_offset2(o1, o4, ax, ay, bx, by))
+    d2 = min(d2, _segment_offset2(o3, o4, ax, ay, bx, by))
+    return math.sqrt(d2)
+
+
+@nb.njit(cache=True, nogil=True)
+def segment_obstacle_dist(ax, ay, bx, by, ob):
+    """Exact distance from segment AB to obstacle row ``ob`` (0 when they meet)."""
+    return _obstacle_dist(ax, ay, bx, by, ob[0], ob[1], ob[2], ob[3], ob[4])
+
+
+#: Relative slack of the obstacle pre-filter in :func:`_link_clearance` (times 1 + the
+#: largest coordinate involved): a million times the rounding error of a distance.
+SKIP_SLACK = 1e-9
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _link_clearance(ax, ay, bx, by, radius, obstacles):
-    """Clearance of one link capsule (segment AB dilated by ``radius``) to all obstacles."""
+    """Clearance of one link capsule (segment AB dilated by ``radius``) to all obstacles.
+
+    An obstacle whose distance cannot be below the best so far is skipped, its distance not
+    computed: the gap between the segment's bounding box and the obstacle's (a circle's
+    centre, then its radius subtracted) is a lower bound of the exact distance, and the skip
+    needs it to beat the best by ``SKIP_SLACK`` x the coordinates' scale, far above the
+    rounding of a computed distance (and, for a box, of its crossing test): a skipped
+    obstacle's computed distance would not have replaced the best. So the value is the one of
+    computing every distance, bit for bit; only the time changes.
+    """
+    lox = min(ax, bx)
+    hix = max(ax, bx)
+    loy = min(ay, by)
+    hiy = max(ay, by)
+    seg_scale = max(abs(lox), abs(hix), abs(loy), abs(hiy))
     best = np.inf
     for o in range(obstacles.shape[0]):
-        d = segment_obstacle_dist(ax, ay, bx, by, obstacles[o]) - radius
+        kind = obstacles[o, 0]
+        o1 = obstacles[o, 1]
+        o2 = obstacles[o, 2]
+        o3 = obstacles[o, 3]
+        o4 = obstacles[o, 4]
+        if best < np.inf:
+            if kind == 0.0:  # circle: centre (o1, o2), radius o3
+                gx = max(lox - o1, 0.0, o1 - hix)
+                gy = max(loy - o2, 0.0, o2 - hiy)
+                reach = best + radius + o3
+                scale = max(seg_scale, abs(o1), abs(o2), abs(o3))
+            else:  # box [o1, o3] x [o2, o4]
+                gx = max(o1 - hix, 0.0, lox - o3)
+                gy = max(o2 - hiy, 0.0, loy - o4)
+                reach = best + radius
+                scale = max(seg_scale, abs(o1), abs(o2), abs(o3), abs(o4))
+            reach += SKIP_SLACK * (1.0 + scale)
+            if reach > 0.0 and gx * gx + gy * gy > reach * reach:
+                continue
+        d = _obstacle_dist(ax, ay, bx, by, kind, o1, o2, o3, o4) - radius
         if d < best:
             best = d
     return best
@@ -277,14 +341,14 @@ def self_clearance(P, seg):
     return best
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def n_distance_pairs(P):
     """Exact element distances one configuration costs: links x obstacles, link pairs of two
     arms and non-adjacent link pairs of one arm (the unit of ``P.work``)."""
     return P.links.shape[0] * P.obstacles.shape[0] + n_link_pairs(P)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def n_link_pairs(P):
     """Link pairs that can touch: pairs of links of two arms, and non-adjacent links of one
     arm (shared by the work count and ``signed.n_elements``)."""
@@ -328,7 +392,7 @@ def clearance_kernel(P, q_deg):
     return best
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def within_limits(limits_deg, q_deg):
     for j in range(q_deg.shape[0]):
         if q_deg[j] < limits_deg[j, 0] or q_deg[j] > limits_deg[j, 1]:
@@ -386,6 +450,92 @@ def self_pair_motion_bound(links, qa_deg, qb_deg, k, m):
     return link_motion_bound(links, qa_deg, qb_deg, m, k + 1)
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def two_link_clearances(P, q0_deg, q1_deg):
+    """Clearance of each link of ONE two-link arm (``P`` has one arm of two links) at the joint
+    angles ``(q0_deg, q1_deg)``: :func:`clearance_kernel`'s per-link values, same arithmetic,
+    without counting work. ``clearance_kernel`` is ``min(min(inf, c0), c1)`` of them."""
+    x = P.bases[0, 0]
+    y = P.bases[0, 1]
+    nx, ny, theta = fk_step(x, y, 0.0, P.links[0], q0_deg)
+    c0 = _link_clearance(x, y, nx, ny, P.radii[0], P.obstacles)
+    mx, my, theta = fk_step(nx, ny, theta, P.links[1], q1_deg)
+    c1 = _link_clearance(nx, ny, mx, my, P.radii[0], P.obstacles)
+    return c0, c1
+
+
+@nb.njit(cache=True, nogil=True)
+def edge_free_two_link(P, qa_deg, qb_deg, margin, ca0, ca1, cb0, cb1):
+    """:func:`edge_free` for ONE arm of two links (the only single-arm case without self
+    pairs: every 2-DOF problem), given the per-link clearances at the ends when known.
+
+    ``(ca0, ca1)`` at ``qa`` and ``(cb0, cb1)`` at ``qb`` (:func:`two_link_clearances`; ``NaN``
+    in the first of a pair: not known, measured here). An edge's first stop is ``qa`` and its
+    last is ``qb``, both bit for bit (``qa + 0 * (qb - qa) == qa``, and the last stop takes
+    ``qb`` itself), so a planner that measured its nodes passes their values instead of having
+    them measured again. Same stops, same verdict, same ``P.work`` as :func:`edge_free` (every
+    stop counts, measured here or given), and no allocation.
+
+    Returns ``(free, c0, c1)``: the verdict and the per-link clearances at ``qa`` (as given,
+    or as measured at the first stop; ``NaN`` when the check ended before measuring them).
+    """
+    if P.obstacles.shape[0] == 0:
+        return True, ca0, ca1
+    clear = P.clearance
+    if margin < clear:
+        return False, ca0, ca1
+    m0 = link_motion_bound(P.links, qa_deg, qb_deg, 0, 0)
+    m1 = link_motion_bound(P.links, qa_deg, qb_deg, 1, 0)
+    per_stop = n_distance_pairs(P)
+    s = 0.0
+    first = True
+    while True:
+        P.work[0] += per_stop
+        if s >= 1.0 and cb0 == cb0:
+            c0 = cb0
+            c1 = cb1
+        elif first and ca0 == ca0:
+            c0 = ca0
+            c1 = ca1
+        else:
+            q0 = qa_deg[0] + s * (qb_deg[0] - qa_deg[0])
+            q1 = qa_deg[1] + s * (qb_deg[1] - qa_deg[1])
+            if s >= 1.0:
+                q0 = qb_deg[0]
+                q1 = qb_deg[1]
+            c0, c1 = two_link_clearances(P, q0, q1)
+            if first:
+                ca0 = c0
+                ca1 = c1
+        first = False
+        # edge_free's per-link checks, link 0 then link 1
+        if not c0 < np.inf:
+            return False, ca0, ca1
+        cmin = np.inf
+        ds = np.inf
+        if c0 < cmin:
+            cmin = c0
+        if m0 > 0.0:
+            step = (c0 - clear) / m0
+            if step < ds:
+                ds = step
+        if not c1 < np.inf:
+            return False, ca0, ca1
+        if c1 < cmin:
+            cmin = c1
+        if m1 > 0.0:
+            step = (c1 - clear) / m1
+            if step < ds:
+                ds = step
+        if cmin <= margin:
+            return False, ca0, ca1
+        if s >= 1.0:
+            return True, ca0, ca1
+        s += ds
+        if s > 1.0:
+            s = 1.0
+
+
 @nb.njit(cache=True, nogil=True)
 def edge_free(P, qa_deg, qb_deg, margin):
     """Certified check of the straight joint segment ``qa -> qb`` (conservative advancement).
@@ -400,6 +550,9 @@ def edge_free(P, qa_deg, qb_deg, margin):
     (an inconsistent call: the steps would go backwards) certifies nothing.
     """
     n_arms = P.arm_first.shape[0] - 1
+    if n_arms == 1 and P.links.shape[0] == 2:  # one two-link arm: no arrays needed
+        nan = np.nan
+        return edge_free_two_link(P, qa_deg, qb_deg, margin, nan, nan, nan, nan)[0]
     obstacles = P.obstacles
     has_obstacles = obstacles.shape[0] > 0
     has_self = has_self_pairs(P)

@@ -14,7 +14,14 @@ import math
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.geometry.collision import clearance_kernel, edge_free, within_limits
+from xfuzzy_rrt.geometry.collision import (
+    clearance_kernel,
+    edge_free,
+    edge_free_two_link,
+    n_distance_pairs,
+    two_link_clearances,
+    within_limits,
+)
 from xfuzzy_rrt.planners.result import (
     ACCEPTED,
     EDGE_BLOCKED,
@@ -25,7 +32,7 @@ from xfuzzy_rrt.planners.result import (
 from xfuzzy_rrt.planners.tree import add_node
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def extend(P, T, near, sample, step, q_near, q_new):
     """Extend tree ``T`` from node ``near`` towards ``sample`` in problem ``P``.
 
@@ -55,6 +62,8 @@ def extend(P, T, near, sample, step, q_near, q_new):
     # config_free, spelt out so that the node keeps the clearance it was accepted with
     if not within_limits(P.limits, q_new):
         return NODE_IN_COLLISION, -1
+    if dof == 2 and P.arm_first.shape[0] == 2:
+        return _extend_two_link(P, T, near, step, q_near, q_new)
     c_new = clearance_kernel(P, q_new)
     if not c_new > P.margin:
         return NODE_IN_COLLISION, -1
@@ -76,3 +85,61 @@ def extend(P, T, near, sample, step, q_near, q_new):
         T.clear[g] = np.nan
         return GOAL_REACHED, g
     return ACCEPTED, k
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _extend_two_link(P, T, near, step, q_near, q_new):
+    """:func:`extend` from the node check on, for one two-link arm (every 2-DOF problem).
+
+    The same checks on the same floats in the same order, hence the same outcome, tree and
+    ``P.work``; what changes is that no clearance is measured twice. The node check measures
+    ``q_new`` per link (:func:`~xfuzzy_rrt.geometry.collision.two_link_clearances`), which is
+    the edge's last stop; the near node's values, kept in ``T.link_clear`` when it was
+    accepted (or measured at its first edge: the root), are the edge's first stop; the goal's
+    are measured once per run. ``T`` must have been grown on ``P``'s geometry (as every
+    planner does: one problem per run).
+    """
+    C = T.link_clear
+    c0, c1 = two_link_clearances(P, q_new[0], q_new[1])
+    P.work[0] += n_distance_pairs(P)
+    c_new = min(min(np.inf, c0), c1)  # clearance_kernel's arithmetic
+    if not c_new > P.margin:
+        return NODE_IN_COLLISION, -1
+    free, a0, a1 = edge_free_two_link(P, q_near, q_new, P.margin, C[near, 0], C[near, 1], c0, c1)
+    C[near, 0] = a0
+    C[near, 1] = a1
+    if not free:
+        return EDGE_BLOCKED, -1
+    k = add_node(T, q_new, near)
+    T.clear[k] = c_new
+    C[k, 0] = c0
+    C[k, 1] = c1
+    goal = P.goal
+    if q_new[0] == goal[0] and q_new[1] == goal[1]:
+        return GOAL_REACHED, k
+    g0 = goal[0] - q_new[0]
+    g1 = goal[1] - q_new[1]
+    if math.sqrt(0.0 + g0 * g0 + g1 * g1) <= step:
+        gi = C.shape[0] - 1
+        if not C[gi, 0] == C[gi, 0]:  # the goal, measured once per run
+            C[gi, 0], C[gi, 1] = two_link_clearances(P, goal[0], goal[1])
+        free, _, _ = edge_free_two_link(P, q_new, goal, P.margin, c0, c1, C[gi, 0], C[gi, 1])
+        if free:
+            g = add_node(T, goal, k)
+            T.clear[g] = np.nan
+            return GOAL_REACHED, g
+    return ACCEPTED, k
+
+
+@nb.njit(cache=True, nogil=True)
+def node_clearance(P, T, i):
+    """``clearance_kernel(P, T.nodes[i])`` (same value, same work), keeping a two-link arm's
+    per-link values in ``T.link_clear`` for the edges that will leave node ``i``."""
+    q = T.nodes[i]
+    if q.shape[0] == 2 and P.arm_first.shape[0] == 2:
+        c0, c1 = two_link_clearances(P, q[0], q[1])
+        P.work[0] += n_distance_pairs(P)
+        T.link_clear[i, 0] = c0
+        T.link_clear[i, 1] = c1
+        return min(min(np.inf, c0), c1)
+    return clearance_kernel(P, q)

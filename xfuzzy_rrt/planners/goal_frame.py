@@ -46,8 +46,7 @@ import numpy as np
 
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
-from xfuzzy_rrt.geometry.collision import clearance_kernel
-from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.extend import extend, node_clearance
 from xfuzzy_rrt.planners.result import ACCEPTED, EDGE_BLOCKED, GOAL_REACHED, NODE_IN_COLLISION
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.trace_record import record_iteration
@@ -196,7 +195,7 @@ def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step
 
     add_node(T, P.start, -1)
     if has_obstacles:
-        T.clear[0] = clearance_kernel(P, T.nodes[0])
+        T.clear[0] = node_clearance(P, T, 0)
     current = 0
     best = _joint_dist(P.start, goal)
     stagnation = 0.0

@@ -62,6 +62,7 @@ def empty_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeArra
     tree, meta0 = hit
     tree.meta[:] = meta0
     tree.cell_head.fill(-1)
+    tree.occ.fill(0)
     return tree
 
 

@@ -37,6 +37,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numba as nb
 import numpy as np
 
 #: Per-iteration outcome codes, shared by planners and traces.
@@ -56,11 +57,16 @@ OUTCOME_NAMES = {
 
 
 def path_cost_deg(path_deg: np.ndarray) -> float:
-    """Sum of Euclidean joint-space segment lengths, in degrees."""
+    """Sum of Euclidean joint-space segment lengths, in degrees.
+
+    The ufuncs are called directly (``np.diff``, ``** 2`` and ``np.sum`` are these same
+    operations behind several layers of argument handling: a third of a short plan's overhead),
+    so the value is the one they give, bit for bit."""
     path = np.asarray(path_deg, dtype=np.float64)
     if path.shape[0] < 2:
         return 0.0
-    return float(np.sum(np.sqrt(np.sum(np.diff(path, axis=0) ** 2, axis=1))))
+    d = path[1:] - path[:-1]
+    return float(np.add.reduce(np.sqrt(np.add.reduce(d * d, axis=1)), axis=0))
 
 
 class _Pending:
@@ -190,6 +196,31 @@ def replace_result(result: PlanResult, **changes: Any) -> PlanResult:
     return new
 
 
+@nb.njit(cache=True, nogil=True)
+def _vertices_within(path, limits):
+    """Every vertex of ``path`` [k, dof] finite and within ``limits`` [dof, 2] (one compiled
+    pass instead of six NumPy calls: this runs after every plan)."""
+    for i in range(path.shape[0]):
+        for j in range(path.shape[1]):
+            v = path[i, j]
+            if not (math.isfinite(v) and v >= limits[j, 0] and v <= limits[j, 1]):
+                return False
+    return True
+
+
+_path_check = None
+
+
+def _path_check_module():
+    """``geometry.path_check``, imported on first use (it imports the planners' neighbours)."""
+    global _path_check
+    if _path_check is None:
+        from xfuzzy_rrt.geometry import path_check
+
+        _path_check = path_check
+    return _path_check
+
+
 def certified_result(arrays, margin: float, found: bool, edges_certified: bool = False,
                      **fields: Any) -> PlanResult:
     """A :class:`PlanResult` whose path (``fields["path_deg"]``) has been certified.
@@ -205,38 +236,33 @@ def certified_result(arrays, margin: float, found: bool, edges_certified: bool =
     re-checked: no certification work is done twice. A certified path's exact clearance is
     measured on first access (module docstring).
     """
-    from xfuzzy_rrt.geometry.path_check import (
-        certify_path,
-        path_min_clearance,
-        segments_certified,
-    )
-
     path = np.asarray(fields["path_deg"], dtype=np.float64)
     if not found or path.size == 0:
         return PlanResult(found=bool(found) and path.size > 0, **fields)
+    checks = _path_check_module()
     if edges_certified and path.ndim == 2 and path.shape[0] >= 2 and path.shape[1] == \
-            arrays.limits_deg.shape[0] and np.all(np.isfinite(path)):
-        lim = arrays.limits_deg
-        if bool(np.all((path >= lim[:, 0]) & (path <= lim[:, 1]))):
-            result = PlanResult(found=True, certified=True, min_clearance_m=_PENDING,
-                                penetration_m=_PENDING, violation=None, **fields)
-            result.__dict__["_measurement"] = functools.partial(path_min_clearance, arrays,
-                                                                path, float(margin))
-            return result
+            arrays.limits_deg.shape[0] and _vertices_within(
+                np.ascontiguousarray(path), np.ascontiguousarray(arrays.limits_deg,
+                                                                 dtype=np.float64)):
+        result = PlanResult(found=True, certified=True, min_clearance_m=_PENDING,
+                            penetration_m=_PENDING, violation=None, **fields)
+        result.__dict__["_measurement"] = functools.partial(checks.path_min_clearance, arrays,
+                                                            path, float(margin))
+        return result
     if path.ndim == 2 and path.shape[0] >= 2 and path.shape[1] == arrays.limits_deg.shape[0] \
             and np.all(np.isfinite(path)):
         # Another planner's path (OMPL's): every segment goes through the certified check now;
         # only when it passes is the exact clearance deferred like ours. A path that fails is
         # measured at once, because its violation sentence names where and how deep.
-        work = segments_certified(arrays, path, margin)
+        work = checks.segments_certified(arrays, path, margin)
         if work is not None:
             result = PlanResult(found=True, certified=True, min_clearance_m=_PENDING,
                                 penetration_m=_PENDING, violation=None, certify_work=work,
                                 **fields)
-            result.__dict__["_measurement"] = functools.partial(path_min_clearance, arrays,
-                                                                path, float(margin))
+            result.__dict__["_measurement"] = functools.partial(checks.path_min_clearance,
+                                                                arrays, path, float(margin))
             return result
-    check = certify_path(arrays, path, margin)
+    check = checks.certify_path(arrays, path, margin)
     return PlanResult(found=True, certified=check.certified,
                       min_clearance_m=float(check.min_clearance_m),
                       penetration_m=float(check.penetration_m),

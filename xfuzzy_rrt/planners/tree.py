@@ -67,6 +67,18 @@ class TreeArrays(NamedTuple):
     #: each node's clearance (m) as measured when it was accepted (NaN where it was not:
     #: a goal joined by the connection step); planners read it instead of measuring again
     clear: np.ndarray
+    #: one two-link arm only (``[capacity + 1, 2]``; ``[1, 2]`` otherwise, unused): each node's
+    #: clearance per link, the values the certified edge check measures at an edge's ends, so
+    #: that an edge leaving or reaching a measured node does not measure it again
+    #: (:func:`xfuzzy_rrt.planners.extend.extend`). The last row holds the goal's. ``NaN`` in
+    #: column 0: not measured in this run (:func:`add_node` writes it for every new node, and
+    #: for the goal row when a run adds its root).
+    link_clear: np.ndarray
+    #: two joints, grids of at most 64 x 64 cells (``[ncy + ncx]``; ``[1]`` otherwise, unused):
+    #: occupied cells as bits, row ``y`` in ``occ[y]`` (bit ``x``) and column ``x`` in
+    #: ``occ[ncy + x]`` (bit ``y``), so that a ring search skips empty cells without reading
+    #: them (:func:`_grid_nearest_occ`); zeroed with ``cell_head``
+    occ: np.ndarray
 
 
 #: ``meta`` slot holding how many nodes the k-d tree covers (the rest are in the buffer).
@@ -108,7 +120,9 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
         np.zeros(kd, dtype=np.int64), np.zeros(kd, dtype=np.int64),
         np.zeros((KD_STACK, 3), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64),
         np.zeros((KD_STACK + 1 if dof > 2 else 1, dof), dtype=np.float64),
-        np.empty(capacity, dtype=np.float64))
+        np.empty(capacity, dtype=np.float64),
+        np.full((capacity + 1 if dof == 2 else 1, 2), np.nan, dtype=np.float64),
+        np.zeros(ncy + ncx if dof == 2 and ncx <= 64 and ncy <= 64 else 1, dtype=np.uint64))
 
 
 
@@ -142,6 +156,7 @@ def _grid_add(cell_next, cell_head, meta, grid, i, x, y):
         meta[BY0] = cy
     if cy > meta[BY1]:
         meta[BY1] = cy
+    return cx, cy
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -204,6 +219,67 @@ def _grid_nearest(nodes, cell_next, cell_head, meta, grid, q):
                         best_d2, best_i, visits = _scan_cell(nodes, cell_next, cell_head,
                                                              yy * ncx + xx, q, best_d2, best_i,
                                                              visits)
+    meta[NN_VISITS] += visits
+    return best_i
+
+
+@nb.njit(cache=True, nogil=True)
+def _grid_nearest_occ(nodes, cell_next, cell_head, meta, grid, occ, q):
+    """:func:`_grid_nearest` reading the occupied-cell bits ``occ`` (``T.occ``): the same rings,
+    the same cells and nodes visited (so the same answer and ``NN_VISITS``), but an empty cell
+    costs a bit test instead of a memory read, and a ring side stops at its last occupied cell.
+
+    Takes the arrays it reads, not the tree: a call passes a tree record as some hundred
+    machine words, which cost as much as a small search."""
+    ncx = meta[NCX]
+    ncy = meta[NCY]
+    cx, cy = _cell_of(grid, meta, q[0], q[1])
+    bx0 = meta[BX0]
+    by0 = meta[BY0]
+    bx1 = meta[BX1]
+    by1 = meta[BY1]
+    r0 = max(bx0 - cx, cx - bx1, by0 - cy, cy - by1, 0)
+    r_max = max(cx - bx0, bx1 - cx, cy - by0, by1 - cy)
+    best_d2 = np.inf
+    best_i = -1
+    visits = 0
+    cell = grid[2]
+    one = np.uint64(1)
+    for r in range(r0, r_max + 1):
+        if best_i >= 0:
+            bound = r - 1 if r >= 1 else 0
+            reach = bound * cell
+            if best_d2 < reach * reach:
+                break
+        y_lo = max(cy - r, by0)
+        y_hi = min(cy + r, by1)
+        for xx in (cx - r, cx + r):
+            if bx0 <= xx <= bx1 and y_lo <= y_hi:
+                bits = occ[ncy + xx] >> np.uint64(y_lo)
+                yy = y_lo
+                while bits != 0 and yy <= y_hi:
+                    if bits & one:
+                        best_d2, best_i, visits = _scan_cell(nodes, cell_next, cell_head,
+                                                             yy * ncx + xx, q, best_d2, best_i,
+                                                             visits)
+                    bits >>= one
+                    yy += 1
+            if r == 0:
+                break
+        if r > 0:
+            x_lo = max(cx - r + 1, bx0)
+            x_hi = min(cx + r - 1, bx1)
+            for yy in (cy - r, cy + r):
+                if by0 <= yy <= by1 and x_lo <= x_hi:
+                    bits = occ[yy] >> np.uint64(x_lo)
+                    xx = x_lo
+                    while bits != 0 and xx <= x_hi:
+                        if bits & one:
+                            best_d2, best_i, visits = _scan_cell(nodes, cell_next, cell_head,
+                                                                 yy * ncx + xx, q, best_d2,
+                                                                 best_i, visits)
+                        bits >>= one
+                        xx += 1
     meta[NN_VISITS] += visits
     return best_i
 
@@ -385,7 +461,7 @@ def _kd_nearest(T, q):
     return best_i
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def add_node(T, q, parent_index):
     """Append configuration ``q`` with its parent; return its index."""
     i = T.meta[N_NODES]
@@ -395,7 +471,15 @@ def add_node(T, q, parent_index):
     T.meta[N_NODES] = i + 1
     dof = T.nodes.shape[1]
     if dof == 2:
-        _grid_add(T.cell_next, T.cell_head, T.meta, T.grid, i, q[0], q[1])
+        # not measured yet (extend writes the values after adding a node it measured); a new
+        # run starts with its root, and its goal is not measured yet either
+        T.link_clear[i, 0] = np.nan
+        if i == 0:
+            T.link_clear[T.link_clear.shape[0] - 1, 0] = np.nan
+        cx, cy = _grid_add(T.cell_next, T.cell_head, T.meta, T.grid, i, q[0], q[1])
+        if T.occ.shape[0] > 1:
+            T.occ[cy] |= np.uint64(1) << np.uint64(cx)
+            T.occ[T.meta[NCY] + cx] |= np.uint64(1) << np.uint64(cy)
     elif i + 1 > _brute_max(dof) and (i + 1 - T.meta[KD_N]) > max(32.0, 2.0 * math.sqrt(i + 1.0)):
         _kd_build(T, i + 1)
     return i
@@ -409,28 +493,37 @@ def _brute_max(dof):
 
 
 @nb.njit(cache=True, nogil=True)
-def _scan_all(T, q):
+def _scan_nodes(nodes, meta, q):
     """Linear scan of every node (lowest index on ties: only a strictly smaller distance
-    replaces the best)."""
-    n = T.meta[N_NODES]
+    replaces the best); the arrays, not the tree (see :func:`_grid_nearest_occ`)."""
+    n = meta[N_NODES]
     best_d2 = np.inf
     best_i = -1
     for i in range(n):
-        d2 = _d2(T.nodes, i, q)
+        d2 = _d2(nodes, i, q)
         if d2 < best_d2:
             best_d2 = d2
             best_i = i
-    T.meta[NN_VISITS] += n
+    meta[NN_VISITS] += n
     return best_i
 
 
 @nb.njit(cache=True, nogil=True)
+def _scan_all(T, q):
+    """:func:`_scan_nodes` of tree ``T``."""
+    return _scan_nodes(T.nodes, T.meta, q)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
 def nearest(T, q):
     """Index of the node nearest to ``q`` (Euclidean, degrees); lowest index on ties."""
     dof = T.nodes.shape[1]
     if T.meta[N_NODES] <= _brute_max(dof):
-        return _scan_all(T, q)
+        return _scan_nodes(T.nodes, T.meta, q)
     if dof == 2:
+        if T.occ.shape[0] > 1:
+            return _grid_nearest_occ(T.nodes, T.cell_next, T.cell_head, T.meta, T.grid, T.occ,
+                                     q)
         return _grid_nearest(T.nodes, T.cell_next, T.cell_head, T.meta, T.grid, q)
     return _kd_nearest(T, q)
 
@@ -440,6 +533,7 @@ def reset_tree(T, meta0):
     """Empty ``T`` for the next run (``meta0``: its ``meta`` when new); no allocation."""
     T.meta[:] = meta0
     T.cell_head[:] = -1
+    T.occ[:] = 0
 
 
 @nb.njit(cache=True, nogil=True)

@@ -219,6 +219,32 @@ def test_cli_wrong_rulebook_is_one_line_exit_2(tmp_path):
     assert not out.exists()
 
 
+def test_the_report_reproduce_command_of_a_connect_run_is_one_plan_accepts(tmp_path):
+    """A report's reproduce line for ``fuzzy-rrt-connect:NAME`` names the Connect planner
+    (``--planner fuzzy-rrt`` would refuse a Connect rulebook), and ``plan`` takes it with
+    ``--rulebook`` like Fuzzy-RRT does; the rerun is the same plan."""
+    import json
+    import shlex
+
+    from xfuzzy_rrt.cli.main import main
+    from xfuzzy_rrt.report.evidence import _plan_cmd
+
+    s = load_scenario(TWO_JOINTS[0])
+    book = rulebooks_dir() / "goal-frame-any"
+    cmd = _plan_cmd(s, "fuzzy-rrt-connect:goal-frame-any", 3,
+                    {"max_iter": 2000, "rulebook_dir": str(book)})
+    args = shlex.split(cmd)
+    assert args[:2] == ["xfuzzy-rrt", "plan"]
+    assert args[args.index("--planner") + 1] == "fuzzy-rrt-connect"
+    out = tmp_path / "r.json"
+    assert main([*args[1:], "--out", str(out)]) == 0
+    rerun = json.loads(out.read_text())
+    direct = plan_scenario(s, "fuzzy-rrt-connect", rulebook=load_rulebook(book), seed=3,
+                           max_iter=2000)
+    assert rerun["iterations"] == direct.iterations
+    assert rerun["rulebook"] == "goal-frame-any"
+
+
 def test_a_dof_free_trace_records_the_rulebook_values_and_the_degrees_used():
     s = single_arm(4, 0)
     r = plan_fuzzy_rrt_connect(s, seed=1, trace=True, max_iter=20_000)

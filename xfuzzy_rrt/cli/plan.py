@@ -26,7 +26,7 @@ def plan(
              "fuzzy-rrt-connect[:NAME|:DIR] (two goal-frame trees; default rulebook goal-frame-any, any arm), or "
              "ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
     rulebook: Optional[Path] = typer.Option(
-        None, "--rulebook", help="Rulebook directory (fuzzy-rrt; default: the shipped default of the problem: goal-frame for one 2-joint arm, else fuzzy-rrt-connect with goal-frame-any, as the JSON's planner_used and rulebook say)."),
+        None, "--rulebook", help="Rulebook directory (fuzzy-rrt, fuzzy-rrt-connect; default: the shipped default of the problem: goal-frame for one 2-joint arm, else fuzzy-rrt-connect with goal-frame-any, as the JSON's planner_used and rulebook say)."),
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Random seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON here (default: stdout)."),
@@ -54,11 +54,12 @@ def plan(
     from xfuzzy_rrt.planners.termination import check_max_time
 
     spec = parse_planner(planner, "--planner")
-    if rulebook is not None and spec.kind != "fuzzy-rrt":
+    if rulebook is not None and spec.kind not in RULEBOOK_KINDS:
         from xfuzzy_rrt.errors import InputError
 
-        raise InputError("--rulebook", f"only fuzzy-rrt plans with a rulebook; --planner "
-                         f"{planner} would ignore it (drop --rulebook or use --planner fuzzy-rrt)")
+        raise InputError("--rulebook", f"only fuzzy-rrt and fuzzy-rrt-connect plan with a "
+                         f"rulebook; --planner {planner} would ignore it (drop --rulebook or "
+                         "use --planner fuzzy-rrt)")
     if trace is not None:
         write_trace_checked(trace)  # reject a bad suffix before any work is done
     check_output_file(out, "--out")

@@ -77,13 +77,24 @@ def _scenario_details(s) -> str:
     return kv_table(pairs)
 
 
+def cli_planner(label: str) -> str:
+    """The ``plan --planner`` value that reruns a benchmark label whose rulebook is passed as
+    ``--rulebook``: ``fuzzy-rrt:NAME`` -> ``fuzzy-rrt``, ``fuzzy-rrt-connect:NAME`` ->
+    ``fuzzy-rrt-connect`` (Fuzzy-RRT refuses a Connect rulebook), anything else itself."""
+    for kind in ("fuzzy-rrt-connect", "fuzzy-rrt"):
+        if label == kind or label.startswith(kind + ":"):
+            return kind
+    return label
+
+
 def _plan_cmd(s, planner: str, seed: int, settings: dict) -> str:
     src = getattr(s, "source", "") or f"{s.name}.toml"
+    planner = cli_planner(planner)
     cmd = (f"xfuzzy-rrt plan {shlex.quote(src)} --planner {shlex.quote(planner)} "
            f"--seed {int(seed)}")
     if settings.get("max_iter") is not None:
         cmd += f" --max-iter {int(settings['max_iter'])}"
-    if planner == "fuzzy-rrt" and settings.get("rulebook_dir"):
+    if planner in ("fuzzy-rrt", "fuzzy-rrt-connect") and settings.get("rulebook_dir"):
         cmd += f" --rulebook {shlex.quote(str(settings['rulebook_dir']))}"
     return cmd
 
@@ -97,7 +108,7 @@ def _follow_one_plan(page: Page, idx: int, s, run, rulebook, grid, settings: dic
     trace = run.trace
     page.heading(f"Rule firing, inputs and outputs, drill-down (seed {int(run.seed)})", level=3,
                  anchor=f"follow-{idx}")
-    plan = _plan_cmd(s, "fuzzy-rrt", run.seed, settings)
+    plan = _plan_cmd(s, settings.get("planner", "fuzzy-rrt"), run.seed, settings)
     page.add(page.figure(firing_heatmap(trace, rulebook), f"fig-s{idx}-firing"))
     page.add(page.figure(io_series(trace, rulebook=rulebook), f"fig-s{idx}-io"))
     page.add(_reproduce_line(f"{plan} --trace trace.parquet"))

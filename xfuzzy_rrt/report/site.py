@@ -89,7 +89,7 @@ def rulebook_dir(planner: str, result) -> str | None:
             return str(entry["dir"])
     if planner == "fuzzy-rrt":
         return settings.get("rulebook_dir")
-    if planner.startswith("fuzzy-rrt:"):
+    if planner.startswith(("fuzzy-rrt:", "fuzzy-rrt-connect:")):
         return planner.split(":", 1)[1]
     return None
 
@@ -492,12 +492,15 @@ def _exists_beside(ctx, name: str) -> bool:
 
 def _plan_cmd(ctx, s, planner: str, seed: int, run=None) -> str:
     src = getattr(s, "source", "") or f"{s.name}.toml"
-    plan_planner = "fuzzy-rrt" if planner.startswith("fuzzy-rrt") else planner
+    from xfuzzy_rrt.report.evidence import cli_planner
+
+    plan_planner = cli_planner(planner)
     cmd = (f"xfuzzy-rrt plan {shlex.quote(src)} --planner {shlex.quote(plan_planner)} "
            f"--seed {int(seed)}")
     if ctx["settings"].get("max_iter") is not None:
         cmd += f" --max-iter {int(ctx['settings']['max_iter'])}"
-    d = rulebook_dir(planner, ctx["result"]) if plan_planner == "fuzzy-rrt" else None
+    d = (rulebook_dir(planner, ctx["result"])
+         if plan_planner in ("fuzzy-rrt", "fuzzy-rrt-connect") else None)
     if d and not _ran_any_arm_default(planner, run):
         cmd += f" --rulebook {shlex.quote(str(d))}"
     return cmd
@@ -592,7 +595,7 @@ def _scenario_page(ctx, idx: int, name: str) -> str:
 
         page.heading(f"Follow one plan: {F.planner_label(p)}", anchor=f"follow-{slug(p)}")
         page.add(_influence_table(r, rb))
-        settings = dict(ctx["settings"])
+        settings = dict(ctx["settings"], planner=p)
         settings["rulebook_dir"] = (None if _ran_any_arm_default(p, r)
                                     else rulebook_dir(p, result))
         _follow_one_plan(page, f"{k}", s, r, rb, grid, settings, n_drill)

@@ -21,10 +21,13 @@
 #          scripts/mutation_test.sh --weaken F [WORKDIR]
 #            instead of mutmut: make one certified step F times non-conservative in the copy
 #            at a time -- (bound) M_k divided by F, (advance) the link-obstacle step
-#            (c_k - clear) / M_k multiplied by F, (armarm) the arm-arm bound M_k + M_m divided
+#            (c_k - clear) / M_k multiplied by F, (advance2) the same step in the
+#            one-two-link-arm path that checks every 2-DOF edge, (armarm) the arm-arm bound M_k + M_m divided
 #            by F, (armarm-max) replaced by max(M_k, M_m), (selfpair) the self-pair relative
 #            bound divided by F, (clearance) the user clearance held F times too leniently by
-#            edge_free, (effective) by effective_margin, (radius) goal-frame clearance_deg
+#            edge_free, (effective) by effective_margin, (minclear-speed, minclear-curvature)
+#            the exact minimum clearance's first- and second-order lower bounds, (radius)
+#            goal-frame clearance_deg
 #            multiplied by F -- and run the test files NAMED AFTER that bound (numba on)
 #            against each. Exit 0 only when every weakening fails its own tests. Try F = 1.05.
 # Env:     PYTHON (default .venv/bin/python), MUTATION_JOBS (default 1), MUTATION_TESTS,
@@ -70,8 +73,8 @@ fi
 cd "$WORK"
 if [ -n "$WEAKEN" ]; then
   status=0
-  for variant in ${WEAKEN_VARIANTS:-bound advance armarm armarm-max selfpair clearance effective radius}; do
-    for f in xfuzzy_rrt/geometry/collision.py xfuzzy_rrt/planners/goal_frame.py; do
+  for variant in ${WEAKEN_VARIANTS:-bound advance advance2 armarm armarm-max selfpair clearance effective minclear-speed minclear-curvature radius}; do
+    for f in xfuzzy_rrt/geometry/collision.py xfuzzy_rrt/geometry/clearance.py xfuzzy_rrt/planners/goal_frame.py; do
       cp "$ROOT/$f" "$f"
     done
     find xfuzzy_rrt -name '*.nbi' -delete -o -name '*.nbc' -delete
@@ -93,6 +96,10 @@ file, old, new, tests = {
     "advance": (collision, "                        step = (ck - clear) / mk\n",
                 f"                        step = (ck - clear) / mk * {F}\n",
                 "tests/test_link_obstacle_bound.py tests/test_margins.py"),
+    # ... the same step in the one-two-link-arm path (edge_free_two_link, every 2-DOF edge) ...
+    "advance2": (collision, "            step = (c{k} - clear) / m{k}\n",
+                 f"            step = (c{{k}} - clear) / m{{k}} * {F}\n",
+                 "tests/test_link_obstacle_bound.py tests/test_margins.py"),
     # ... the arm-arm bound M_k + M_m, weakened by F or replaced by max (issue 22) ...
     "armarm": (collision, "                            mkm = mka + mks[m]\n",
                f"                            mkm = (mka + mks[m]) / {F}\n",
@@ -113,6 +120,16 @@ file, old, new, tests = {
                   f"    return CERT_MARGIN_M + float(clearance_m) / {F}\n",
                   "tests/test_margins.py"),
     # ... and clearance_deg, the goal-frame input that claims a certified joint-space radius.
+    # ... the exact minimum clearance's lower bounds (geometry/clearance.py): the element
+    # speed (first order) and the curvature constant K (second order, flat minima) ...
+    "minclear-speed": ("xfuzzy_rrt/geometry/clearance.py",
+                       "    lb1 = 0.5 * (c0 + c1 - v * width)\n",
+                       f"    lb1 = 0.5 * (c0 + c1 - v / {F} * width)\n",
+                       "tests/test_flat_minimum_clearance.py"),
+    "minclear-curvature": ("xfuzzy_rrt/geometry/clearance.py",
+                           "    half_k = 0.5 * (acc + v * v / d) * width * width  # K width² / 2\n",
+                           f"    half_k = 0.5 * (acc + v * v / d) * width * width / {F}\n",
+                           "tests/test_flat_minimum_clearance.py"),
     "radius": ("xfuzzy_rrt/planners/goal_frame.py",
                "    deg_per_m = math.degrees(1.0) / problem_lever(P)\n",
                f"    deg_per_m = math.degrees(1.0) / problem_lever(P) * {F}\n",
@@ -120,9 +137,15 @@ file, old, new, tests = {
 }[variant]
 path = Path(file)
 text = path.read_text()
-if text.count(old) != 1:
-    sys.exit(f"error: cannot find the {variant} code to weaken in {path}")
-path.write_text(text.replace(old, new))
+# "{k}" stands for each link of the two-link path (0 and 1); every other pattern appears once,
+# or once per edge-check path (the user clearance is read by both): all of them are weakened.
+pairs = ([(old.replace("{k}", str(k)), new.replace("{k}", str(k))) for k in (0, 1)]
+         if "{k}" in old else [(old, new)])
+for o, n in pairs:
+    if text.count(o) < 1:
+        sys.exit(f"error: cannot find the {variant} code to weaken in {path}")
+    text = text.replace(o, n)
+path.write_text(text)
 print(tests)
 PYEOF
 )

@@ -428,6 +428,9 @@ EDGE_CASES += [
     ("obstacles-key-inside-goal", {"obstacles": "obstacles = []"},
      "reject:unknown key 'obstacles' in [goal]"),
     ("links-1e-9", {"links": "[1e-9, 1e-9]", "link_radius": "0.0"}, "accept"),
+    # found by the fuzzer: subnormal links squared to 0 and divided by zero in the planner
+    ("links-subnormal", {"links": "[5e-324, 5e-324]"},
+     "reject:arm.links[0]: link length must be at least 1e-09 m"),
     ("start-on-joint-limits", {"start": "[-170.0, 160.0]", "goal": "[170.0, -160.0]",
                                "obstacles": circles([(0.0, 0.5, 0.05)])}, "accept"),
     ("limits-wider-than-a-turn", {"limits": "[[-190.0, 170.0], [-160.0, 160.0]]"},

@@ -35,7 +35,9 @@ def _graze(links, shape: str, gap: float, depth: float):
 
 
 CASES = [(links, shape, gap, depth, alpha, past)
-         for links in ((0.3,), (0.12, 0.1, 0.08))
+         # one, two and three links: a two-link arm (every 2-DOF problem) is checked by its
+         # own allocation-free path, edge_free_two_link, which must be pinned as tightly
+         for links in ((0.3,), (0.17, 0.13), (0.12, 0.1, 0.08))
          for shape in ("circle", "box")
          for gap in (5e-5, 3e-4)
          for depth in (0.005, 0.05)
@@ -58,14 +60,17 @@ def test_link_obstacle_bound_refuses_a_tip_grazing_a_small_obstacle(links, shape
     assert not edge_free(P, qa, qb, CERT_MARGIN_M)
 
 
+@pytest.mark.parametrize("links", [(0.17, 0.13), (0.12, 0.1, 0.08)])
 @pytest.mark.parametrize("shape", ["circle", "box"])
-def test_link_obstacle_bound_certifies_the_same_sweep_passing_just_clear(shape):
-    links = np.array([0.12, 0.1, 0.08])
+def test_link_obstacle_bound_certifies_the_same_sweep_passing_just_clear(shape, links):
+    links = np.array(links)
+    n = links.shape[0]
     obstacles, radius = _graze(links, shape, 3e-4, -0.2)
-    qa, qb = np.array([-9.0, 0.0, 0.0]), np.array([9.0, 0.0, 0.0])
+    qa, qb = np.zeros(n), np.zeros(n)
+    qa[0], qb[0] = -9.0, 9.0
     w = World.from_obstacle_rows([(links, (0.0, 0.0), radius)], obstacles)
     assert w.segment_min_clearance(qa, qb).lower > CERT_MARGIN_M
-    P = single_arm_problem(links, np.zeros(2), radius, obstacles, np.tile([-180.0, 180.0], (3, 1)))
+    P = single_arm_problem(links, np.zeros(2), radius, obstacles, np.tile([-180.0, 180.0], (n, 1)))
     assert edge_free(P, qa, qb, CERT_MARGIN_M)
 
 

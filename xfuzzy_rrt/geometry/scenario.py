@@ -34,6 +34,11 @@ BOX = 1
 #: that, float64 rounding outgrows the 1 µm certification margin. 1e6 m keeps rounding errors
 #: below 1e-9 m while allowing any plausible unit mistake (millimetres for metres).
 MAX_EXTENT_M = 1e6
+#: Shortest link (metres). The certified check and the goal-frame inputs scale by sums of
+#: squared link lengths, which underflow to 0 below ~1e-154 m (a subnormal 5e-324 m link made
+#: a division by zero); a link a millionth of the 1 µm certification margin is no link a
+#: planner can reason about either, so 1 nm is the floor.
+MIN_LINK_M = 1e-9
 
 
 @dataclass(frozen=True)
@@ -412,6 +417,9 @@ def _read_arm(r: _Reader, arm_t: dict[str, Any], key: str) -> Arm:
     for i, length in enumerate(links):
         if length <= 0:
             raise r.fail(f"{key}.links[{i}]", f"link length must be > 0, got {length:g}")
+        if length < MIN_LINK_M:
+            raise r.fail(f"{key}.links[{i}]", f"link length must be at least {MIN_LINK_M:g} m "
+                         f"(shorter links underflow the certified check), got {length:g}")
     base = r.lengths(arm_t.get("base", [0.0, 0.0]), f"{key}.base", length=2)
     link_radius = r.extent(r.number(arm_t.get("link_radius", 0.0), f"{key}.link_radius"),
                            f"{key}.link_radius")

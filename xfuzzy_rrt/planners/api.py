@@ -246,7 +246,7 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
             from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt as plan_fuzzy
         result = plan_fuzzy(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
                             trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
-        if result.planner == spec.label == kind:  # the plain name: nothing to relabel (no copy)
+        if result.planner == spec.label and result.planner_used == kind:  # nothing to relabel
             return result
         return replace_result(result, planner=spec.label, planner_used=kind)
     from xfuzzy_rrt.planners.ompl_bridge import plan_ompl

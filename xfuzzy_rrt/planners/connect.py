@@ -392,7 +392,8 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         recorded["max_time_s"] = float(params["max_time_s"])
         recorded["stopped_by"] = stopped_by(ok, int(iterations), int(max_iter), flag)
     result = certified_result(
-        a, margin, ok, scenario=scenario.name, planner=PLANNER, seed=int(seed),
+        a, margin, ok, scenario=scenario.name, planner=PLANNER, planner_used=PLANNER,
+        seed=int(seed),
         iterations=int(iterations), nodes=na + nb_,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=nodes, tree_parent=parent, rulebook=rb.name,

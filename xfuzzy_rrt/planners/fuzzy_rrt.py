@@ -330,6 +330,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
     result = certified_result(
         a, margin, bool(ok), edges_certified=True, scenario=scenario.name, planner="fuzzy-rrt",
+        planner_used="fuzzy-rrt",
         seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,

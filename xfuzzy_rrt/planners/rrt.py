@@ -111,6 +111,7 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
     return certified_result(
         a, margin, bool(ok), edges_certified=True, scenario=scenario.name, planner="rrt",
+        planner_used="rrt",
         seed=int(seed),
         iterations=int(iterations), nodes=n,
         cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,

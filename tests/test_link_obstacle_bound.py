@@ -83,3 +83,31 @@ def test_link_obstacle_bound_matches_the_tip_speed_of_a_straight_arm():
     qb2 = np.array([10.0, -4.0, 6.0])
     expected = math.radians(10.0) * 0.3 + math.radians(4.0) * 0.18 + math.radians(6.0) * 0.08
     assert link_motion_bound(links, qa, qb2, 2, 0) == pytest.approx(expected)
+
+
+@pytest.mark.parametrize("links", [(0.3,), (0.17, 0.13), (0.12, 0.1, 0.08)])
+def test_an_edge_check_asked_for_less_than_the_clearance_certifies_nothing(links):
+    """A margin below the problem's clearance is an inconsistent call (the steps
+    ``(c_k - clear) / M_k`` would be measured against more than the stops are checked for):
+    nothing is certified, on a free edge far from the only obstacle, on every path of the
+    check (the two-link one too: a mutant that certified here survived the suite once)."""
+    links = np.array(links)
+    n = links.shape[0]
+    far = np.array([[0.0, 5.0, 5.0, 0.01, 0.0]])
+    P = single_arm_problem(links, np.zeros(2), 0.005, far, np.tile([-180.0, 180.0], (n, 1)),
+                           margin=0.01)
+    qa, qb = np.zeros(n), np.full(n, 10.0)
+    assert edge_free(P, qa, qb, 0.01)  # consistent: free and certified
+    assert not edge_free(P, qa, qb, CERT_MARGIN_M)
+
+
+@pytest.mark.parametrize("links", [(0.3,), (0.17, 0.13), (0.12, 0.1, 0.08)])
+def test_an_obstacle_with_a_nan_coordinate_is_never_certified_past(links):
+    """A NaN clearance (a NaN obstacle row) is not a free stop, on every path of the check."""
+    links = np.array(links)
+    n = links.shape[0]
+    nan_box = np.array([[1.0, math.nan, -1.0, 3.0, 1.0]])
+    P = single_arm_problem(links, np.zeros(2), 0.005, nan_box, np.tile([-180.0, 180.0], (n, 1)))
+    qa, qb = np.zeros(n), np.zeros(n)
+    qa[0], qb[0] = 45.0, -45.0
+    assert not edge_free(P, qa, qb, CERT_MARGIN_M)

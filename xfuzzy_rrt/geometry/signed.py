@@ -8,11 +8,9 @@ two link segments of different arms. Outside, every function agrees with the uns
 
 ``element_clearances`` is the view the branch and bound of ``clearance.py`` works on: one
 signed clearance per *element* -- each link against the obstacles, then each pair of links of
-different arms, then each pair of non-adjacent links of one arm (self-collision) -- with
-``element_motion_bounds`` the matching Lipschitz constants of the certified check (``M_k``,
-``M_k + M_m``, and ``collision.self_pair_motion_bound`` for a self pair); the branch and bound
-itself uses the tighter speed and the curvature constants of
-``clearance.element_speed_accel``.
+different arms, then each pair of non-adjacent links of one arm (self-collision); the branch
+and bound bounds how fast each moves with ``clearance.element_speed_accel`` (a speed and a
+curvature constant per element).
 """
 
 from __future__ import annotations
@@ -24,10 +22,8 @@ import numpy as np
 
 from xfuzzy_rrt.geometry.collision import (
     _point_segment_dist,
-    link_motion_bound,
     link_segments_into,
     n_link_pairs,
-    self_pair_motion_bound,
     segment_obstacle_dist,
     segment_segment_dist,
 )
@@ -164,30 +160,6 @@ def element_clearances(P, q_deg, out):
                 e += 1
     P.work[0] += nl * obstacles.shape[0] + (e - nl)  # the work counter (geometry/problem.py)
     return best
-
-
-@nb.njit(cache=True, nogil=True)
-def element_motion_bounds(P, qa_deg, qb_deg, out):
-    """Lipschitz constant (m per unit of the segment ``qa -> qb``) of every element's clearance:
-    ``M_k`` of its link, ``M_k + M_m`` for a pair of links of different arms, the relative
-    bound ``self_pair_motion_bound`` for two non-adjacent links of one arm."""
-    n_arms = P.arm_first.shape[0] - 1
-    for a in range(n_arms):
-        f = P.arm_first[a]
-        for k in range(f, P.arm_first[a + 1]):
-            out[k] = link_motion_bound(P.links, qa_deg, qb_deg, k, f)
-    e = P.links.shape[0]
-    for a in range(n_arms):
-        for b in range(a + 1, n_arms):
-            for k in range(P.arm_first[a], P.arm_first[a + 1]):
-                for m in range(P.arm_first[b], P.arm_first[b + 1]):
-                    out[e] = out[k] + out[m]
-                    e += 1
-    for a in range(n_arms):
-        for k in range(P.arm_first[a], P.arm_first[a + 1]):
-            for m in range(k + 2, P.arm_first[a + 1]):
-                out[e] = self_pair_motion_bound(P.links, qa_deg, qb_deg, k, m)
-                e += 1
 
 
 @nb.njit(cache=True, nogil=True)

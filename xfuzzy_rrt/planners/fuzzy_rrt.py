@@ -130,6 +130,24 @@ def check_rulebook_fits(rb, scenario: Scenario) -> None:
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
+def arm_inputs(P, a, q, goal_ws, has_obstacles, no_obstacle_dist):
+    """The paper's four fuzzy inputs of arm ``a`` at ``q``: ``(angle to goal, distance to goal,
+    angle to the nearest obstacle, distance to it)``, from its end effector; with nothing to
+    hit the obstacle distance is ``no_obstacle_dist`` (the input's top) and its angle 0. One
+    definition for the planner kernel and the training loop (``training/memo.py``)."""
+    ex, ey = arm_end_effector(P, a, q)
+    d_obs = no_obstacle_dist
+    a_obs = 0.0
+    if has_obstacles:
+        d, ang, _ = nearest_obstacle_for_arm(P, a, q, ex, ey)
+        if d < np.inf:
+            d_obs = d
+            a_obs = ang
+    d_goal, a_goal = direction_and_distance(ex, ey, goal_ws[a, 0], goal_ws[a, 1])
+    return a_goal, d_goal, a_obs, d_obs
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
 def _interval(lo_raw, hi_raw, offset, limit_lo, limit_hi):
     """Ordered, offset and clipped sampling interval (see the module docstring)."""
     lo = min(lo_raw, hi_raw) + offset
@@ -187,15 +205,8 @@ def fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode, min_step,
         step_min = np.inf
         for a in range(n_arms):
             # 1-2. Fuzzy inputs from this arm's end effector.
-            ex, ey = arm_end_effector(P, a, q)
-            d_obs = no_obstacle_dist
-            a_obs = 0.0
-            if has_obstacles:
-                d, ang, _ = nearest_obstacle_for_arm(P, a, q, ex, ey)
-                if d < np.inf:
-                    d_obs = d
-                    a_obs = ang
-            d_goal, a_goal = direction_and_distance(ex, ey, goal_ws[a, 0], goal_ws[a, 1])
+            a_goal, d_goal, a_obs, d_obs = arm_inputs(P, a, q, goal_ws, has_obstacles,
+                                                      no_obstacle_dist)
             xa = x[4 * a:4 * a + 4]
             ya = y[n_out * a:n_out * (a + 1)]
             xa[0] = a_goal

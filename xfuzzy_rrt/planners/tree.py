@@ -508,12 +508,6 @@ def _scan_nodes(nodes, meta, q):
     return best_i
 
 
-@nb.njit(cache=True, nogil=True)
-def _scan_all(T, q):
-    """:func:`_scan_nodes` of tree ``T``."""
-    return _scan_nodes(T.nodes, T.meta, q)
-
-
 @nb.njit(cache=True, nogil=True, inline="always")
 def nearest(T, q):
     """Index of the node nearest to ``q`` (Euclidean, degrees); lowest index on ties."""

@@ -34,10 +34,9 @@ import numpy as np
 
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
-from xfuzzy_rrt.geometry.collision import direction_and_distance, nearest_obstacle_for_arm
 from xfuzzy_rrt.geometry.kinematics import arm_end_effector
 from xfuzzy_rrt.planners.extend import extend
-from xfuzzy_rrt.planners.fuzzy_rrt import BOUNDS_RELATIVE, _interval
+from xfuzzy_rrt.planners.fuzzy_rrt import BOUNDS_RELATIVE, _interval, arm_inputs
 from xfuzzy_rrt.planners.result import ACCEPTED, GOAL_REACHED
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.tree import _d2, add_node, nearest, reset_tree
@@ -87,15 +86,8 @@ def paper_run(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, memo, 
             bias_sum = 0.0
             step_min = np.inf
             for a in range(n_arms):
-                ex, ey = arm_end_effector(P, a, q)
-                d_obs = no_obstacle_dist
-                a_obs = 0.0
-                if has_obstacles:
-                    d, ang, _ = nearest_obstacle_for_arm(P, a, q, ex, ey)
-                    if d < np.inf:
-                        d_obs = d
-                        a_obs = ang
-                d_goal, a_goal = direction_and_distance(ex, ey, goal_ws[a, 0], goal_ws[a, 1])
+                a_goal, d_goal, a_obs, d_obs = arm_inputs(P, a, q, goal_ws, has_obstacles,
+                                                          no_obstacle_dist)
                 x[0] = a_goal
                 x[1] = d_goal
                 x[2] = a_obs

@@ -4,6 +4,8 @@ benchmarks/overhead.py, never asserted here."""
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import os
 import pickle
 import re
@@ -14,10 +16,22 @@ import numpy as np
 import pytest
 
 import xfuzzy_rrt.fuzzy.rulebook as rbmod
+from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.planners import setup_memo
+from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
+from xfuzzy_rrt.planners.result import (
+    _PENDING,
+    PlanResult,
+    _certified,
+    finish_tree_run,
+    path_cost_compiled,
+    path_cost_deg,
+)
 import xfuzzy_rrt.geometry.path_check as path_check
 from xfuzzy_rrt.geometry.path_check import certify_path
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.api import plan_scenario
+from xfuzzy_rrt.planners.rrt import plan_rrt
 from xfuzzy_rrt.planners.result import replace_result
 from xfuzzy_rrt.resources import demo_scenarios
 
@@ -154,3 +168,102 @@ def test_a_freshly_written_rulebook_is_rehashed_until_its_stamps_can_be_trusted(
     rbmod.load_rulebook_cached(root)
     rbmod.load_rulebook_cached(root)
     assert len(hashed) == 2
+
+
+# --- the compiled finish of a tree planner's run, and the fast result -----------------------
+
+
+
+def test_the_compiled_path_cost_is_numpys_float_bit_for_bit():
+    # NumPy sums pairwise (8 running sums up to 128 terms, halves beyond): a plain loop
+    # differs in the last bits, which golden files would catch one plan at a time
+    rng = np.random.default_rng(5)
+    for dof in (1, 2, 3, 5, 7, 8, 9, 14, 16, 17, 28):
+        for k in (*range(0, 20), 63, 64, 65, 127, 128, 129, 130, 300, 1031, 4099):
+            path = rng.uniform(-180.0, 180.0, (k, dof)) * rng.choice([1e-3, 1.0, 1e3])
+            assert path_cost_compiled(path) == path_cost_deg(path), (dof, k)
+
+
+def test_finishing_a_run_copies_the_tree_and_flags_a_vertex_beyond_the_limits():
+    nodes = np.array([[0.0, 0.0], [10.0, 5.0], [20.0, 30.0], [9.0, 9.0]])
+    parent = np.array([-1, 0, 1, 0], dtype=np.int64)
+    limits = np.array([[-180.0, 180.0], [-180.0, 180.0]])
+    tn, tp, path, cost, within = finish_tree_run(nodes, parent, 3, 2, limits)
+    assert np.array_equal(path, nodes[:3]) and within and cost == path_cost_deg(nodes[:3])
+    assert np.array_equal(tn, nodes[:3]) and np.array_equal(tp, parent[:3])
+    tn[0, 0] = 99.0  # copies: the tree is reused by the next plan
+    assert nodes[0, 0] == 0.0
+    tight = np.array([[-180.0, 180.0], [-180.0, 29.0]])
+    assert not finish_tree_run(nodes, parent, 3, 2, tight)[4]
+    nodes[1, 0] = np.nan
+    assert not finish_tree_run(nodes, parent, 3, 2, limits)[4]
+    none = finish_tree_run(nodes, parent, 4, -1, limits)
+    assert none[2].shape == (0, 2) and not none[4]
+
+
+def test_the_fast_certified_result_is_the_dataclass_one_field_for_field():
+    p = np.zeros((3, 2))
+    fields = dict(scenario="s", planner="fuzzy-rrt", planner_used="fuzzy-rrt", seed=3,
+                  iterations=5, nodes=4, cost_deg=1.5, wall_s=0.1, path_deg=p, tree_nodes_deg=p,
+                  tree_parent=np.zeros(3, dtype=np.int64), work=7, rulebook="goal-frame",
+                  rulebook_sha256="ab", params={"max_iter": 10})
+    fast = _certified(dict(fields))
+    slow = PlanResult(found=True, certified=True, min_clearance_m=_PENDING,
+                      penetration_m=_PENDING, violation=None, **fields)
+    assert type(fast) is PlanResult
+    assert fast.__dict__.keys() == slow.__dict__.keys()
+    for k, v in slow.__dict__.items():
+        assert fast.__dict__[k] is v or fast.__dict__[k] == v, k
+    assert fast.success and fast.certify_work == 0 and fast.trace is None
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.seed = 4
+    # a field the fast path does not take goes through __init__ (and its checks)
+    with pytest.raises(TypeError):
+        _certified({**fields, "found": False})
+
+
+@pytest.fixture()
+def fresh_memo():
+    setup_memo.clear()
+    yield
+    setup_memo.clear()
+
+
+def test_a_remembered_set_up_never_hides_an_error_or_a_different_setting(scenarios, fresh_memo):
+    s = scenarios[0]
+    good = plan_fuzzy_rrt(s, seed=1, max_iter=500)
+    for _ in range(2):  # errors are never remembered: the same line every time
+        with pytest.raises(InputError, match="must be an integer"):
+            plan_fuzzy_rrt(s, seed=1, max_iter=500.0)
+        with pytest.raises(InputError, match="must be an integer"):
+            plan_rrt(s, seed=1, max_iter=True)
+    # equal in Python, not to the checks: True is not 1, -0.0 is not 0.0
+    plan_rrt(s, seed=1, max_iter=1)
+    with pytest.raises(InputError):
+        plan_rrt(s, seed=1, max_iter=True)
+    plus = plan_rrt(s, seed=1, margin=0.0)
+    minus = plan_rrt(s, seed=1, margin=-0.0)
+    assert math.copysign(1, plus.params["margin_m"]) == 1.0
+    assert math.copysign(1, minus.params["margin_m"]) == -1.0
+    again = plan_fuzzy_rrt(s, seed=1, max_iter=500)
+    assert again.iterations == good.iterations and again.params == good.params
+
+
+def test_a_remembered_set_up_follows_an_edited_rulebook_and_a_new_scenario_object(
+        scenarios, rulebook_copy, fresh_memo):
+    root, _hashed = rulebook_copy
+    s = scenarios[0]
+    first = plan_fuzzy_rrt(s, root, seed=2)
+    assert plan_fuzzy_rrt(s, root, seed=2).rulebook_sha256 == first.rulebook_sha256
+    fis = sorted(root.glob("*.fis"))[0]
+    time.sleep(0.05)
+    fis.write_text(_edit_same_size(fis))
+    edited = plan_fuzzy_rrt(s, root, seed=2)
+    assert edited.rulebook_sha256 != first.rulebook_sha256
+    assert edited.rulebook_sha256 == rbmod.load_rulebook(root).sha256
+    # a different (equal) scenario object is checked afresh, not matched by a recycled id
+    copy = dataclasses.replace(s, clearance_m=s.clearance_m)
+    key_count = len(setup_memo._memo)
+    plan_fuzzy_rrt(copy, root, seed=2)
+    assert len(setup_memo._memo) == key_count + 1
+    assert setup_memo.lookup(("no such key",), s) is None

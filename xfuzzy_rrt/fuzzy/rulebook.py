@@ -301,8 +301,21 @@ def _shipped_rulebooks_dir() -> Path:
 
 
 def default_rulebook_path() -> Path:
-    """Directory of the default rulebook (``general``: trained on generated problems only)."""
+    """Directory of the default rulebook (``goal-frame``: trained on generated problems only)."""
     return rulebooks_dir() / DEFAULT_RULEBOOK
+
+
+@functools.lru_cache(maxsize=8)
+def _default_dir_str(env: str | None) -> str:
+    return os.path.abspath(Path(env) / DEFAULT_RULEBOOK if env else
+                           _shipped_rulebooks_dir() / DEFAULT_RULEBOOK)
+
+
+def default_rulebook_str() -> str:
+    """:func:`default_rulebook_path` as an absolute string, what every plan call without a
+    rulebook looks up: the environment is read on every call (it may change), the path built
+    once per value of it."""
+    return _default_dir_str(os.environ.get(RULEBOOKS_ENV) or None)
 
 
 def _content_key(root: Path) -> str:
@@ -310,7 +323,7 @@ def _content_key(root: Path) -> str:
 
     Why the bytes and not only (mtime, size, inode): ``cp -p``, ``rsync -t`` or ``tar x`` can
     put different bytes of the same size under the same modification time. The bytes are hashed
-    only when :func:`_stat_key` says a file may have changed (see :func:`load_rulebook_cached`).
+    only when :func:`_unchanged` says a file may have changed (see :func:`load_rulebook_cached`).
     """
     h = hashlib.sha256()
     fis_names = sorted(p.name for p in root.glob("*" + SUFFIX)) if root.is_dir() else []
@@ -329,24 +342,43 @@ def _stamp(st: os.stat_result) -> tuple[int, int, int, int]:
     return st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino
 
 
-def _stat_key(root: str, paths: tuple[str, ...]) -> tuple:
-    """(size, mtime_ns, ctime_ns, inode) of the directory and of each of its files ``paths``.
+def _unchanged(paths: tuple[str, ...], stamps: tuple) -> bool:
+    """Every one of ``paths`` (the directory first) still has its recorded stamps.
 
-    Why ctime too: a same-size edit whose mtime is put back (``os.utime``, ``touch -r``,
-    ``cp -p``) still sets the ctime to *now*, which no user call can forge. The directory's own
-    stamps change when a file is added, removed or renamed over (an atomic save), so every file
-    of the directory counts without listing it again on every look-up.
-    """
+    The stamps are (size, mtime_ns, ctime_ns, inode). Why ctime too: a same-size edit whose
+    mtime is put back (``os.utime``, ``touch -r``, ``cp -p``) still sets the ctime to *now*,
+    which no user call can forge. The directory's own stamps change when a file is added,
+    removed or renamed over (an atomic save), so every file of the directory counts without
+    listing it again on every look-up. This is the look-up every plan call makes: one ``stat``
+    per path and nothing else (in a VM a stat costs ~3 us, a call's whole budget ~100 us).
+    Stops at the first difference."""
     stat = os.stat
-    return (_stamp(stat(root)), *[_stamp(stat(p)) for p in paths])
+    try:
+        for p, (size, mtime, ctime, ino) in zip(paths, stamps):
+            st = stat(p)
+            if st.st_mtime_ns != mtime or st.st_ctime_ns != ctime or st.st_size != size \
+                    or st.st_ino != ino:
+                return False
+    except OSError:
+        return False
+    return True
+
+
+def _content_files(root: str) -> tuple[str, ...]:
+    """The directory's files whose bytes make the rulebook: its manifest and FIS files.
+
+    Other files (a training ``history.csv``, notes) are not watched one by one: none of them is
+    read by :func:`load_rulebook`, and adding, removing or renaming any file changes the
+    directory's own stamps anyway."""
+    return tuple(n for n in sorted(os.listdir(root)) if n == MANIFEST_NAME or n.endswith(SUFFIX))
 
 
 #: A file stamped this close to the moment its directory was looked at could be edited again
 #: within the same timestamp tick (coarse kernel clocks; 2 s on FAT): such an entry is
 #: "racy" and is re-hashed on every look-up until its files are older (as git does).
 RACY_WINDOW_NS = 2_000_000_000
-#: ``absolute path -> (its files' paths, stat key, real path, content key, racy)``: the last
-#: look-up of each directory.
+#: ``path as given (absolute) -> (watched paths, their stamps, real path, content key, racy,
+#: rulebook)``: the last look-up of each directory.
 _STAT_CACHE: dict[str, tuple] = {}
 
 
@@ -359,33 +391,32 @@ def load_rulebook_cached(path: str | os.PathLike[str]) -> "Rulebook":
     """:func:`load_rulebook`, but parse a directory only once while its files' bytes are unchanged.
 
     Why: library callers plan many times with the default rulebook; parsing 3,750 rules costs
-    ~50-130 ms, a plan well under 1 ms. A look-up stats the directory's files (tens of
-    microseconds); only when a size, mtime, ctime or inode changed, or the files are too young
-    to trust their stamps (:data:`RACY_WINDOW_NS`), are the bytes re-read and re-hashed, and
-    only new bytes are parsed again. Rulebooks are immutable, so sharing one object between
-    calls is safe.
+    ~50-130 ms, a plan well under 1 ms. A look-up stats the directory and its manifest and FIS
+    files (:func:`_unchanged`, a few microseconds each); only when a size, mtime, ctime or inode
+    changed, or the files are too young to trust their stamps (:data:`RACY_WINDOW_NS`), are the
+    bytes re-read and re-hashed, and only new bytes are parsed again. Rulebooks are immutable,
+    so sharing one object between calls is safe. An absolute path given as a string is its own
+    key (no normalisation on the hot path); any other is made absolute first, so a relative
+    path follows the current directory.
     """
-    key = os.path.abspath(path)
+    key = path if type(path) is str and path[:1] == "/" else os.path.abspath(path)
     seen = _STAT_CACHE.get(key)
-    if seen is not None and not seen[4]:
-        try:
-            if _stat_key(key, seen[0]) == seen[1]:
-                return _load_cached(seen[2], seen[3])
-        except OSError:
-            pass
+    if seen is not None and not seen[4] and _unchanged(seen[0], seen[1]):
+        return seen[5]
     root = os.path.realpath(path)
     if not os.path.isdir(root):
         return load_rulebook(root)  # raises the usual one-line error
     now = time.time_ns()
     try:
-        names = tuple(os.path.join(key, n) for n in sorted(os.listdir(root)))
-        stat_key = _stat_key(key, names)
+        paths = (key, *(os.path.join(key, n) for n in _content_files(root)))
+        stamps = tuple(_stamp(os.stat(p)) for p in paths)
     except OSError:
         return load_rulebook(root)
-    newest = max(max(st[1], st[2]) for st in stat_key)
+    newest = max(max(st[1], st[2]) for st in stamps)
     content = _content_key(Path(root))
-    _STAT_CACHE[key] = (names, stat_key, root, content, newest >= now - RACY_WINDOW_NS)
-    return _load_cached(root, content)
+    rulebook = _load_cached(root, content)
+    _STAT_CACHE[key] = (paths, stamps, root, content, newest >= now - RACY_WINDOW_NS, rulebook)
+    return rulebook
 
 
 def list_rulebooks() -> list[Path]:

@@ -49,6 +49,7 @@ Choices where the paper is silent or ambiguous (and why):
 from __future__ import annotations
 
 import time
+from typing import Any, NamedTuple
 
 import numba as nb
 import numpy as np
@@ -59,18 +60,20 @@ from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.collision import direction_and_distance, nearest_obstacle_for_arm
 from xfuzzy_rrt.geometry.kinematics import arm_end_effector
-from xfuzzy_rrt.geometry.problem import Problem
+from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
 from xfuzzy_rrt.planners.extend import extend
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.params import default, resolve_params
-from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, path_cost_deg
+from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
+                                         finish_tree_run, replace_result)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
 from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
-from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, extract_path, nearest, reset_tree
+from xfuzzy_rrt.planners.setup_memo import exact, lookup, remember, rulebook_token
+from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, nearest, reset_tree
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
 MIN_STEP_DEG = default("fuzzy-rrt", "min_step_deg")
@@ -278,13 +281,70 @@ def entry_for(mode: int):
 
 def _resolve_rulebook(rulebook):
     """A loaded rulebook as given, else the (cached) directory or shipped default."""
-    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_path, load_rulebook_cached
+    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_str, load_rulebook_cached
 
     if rulebook is None:
-        rulebook = default_rulebook_path()
-    if hasattr(rulebook, "compiled"):
+        rulebook = default_rulebook_str()
+    elif hasattr(rulebook, "compiled"):
         return rulebook
     return load_rulebook_cached(rulebook)
+
+
+class _Setup(NamedTuple):
+    """Everything a Fuzzy-RRT call checks and builds before its kernel (see
+    :mod:`xfuzzy_rrt.planners.setup_memo`): the same for every seed."""
+
+    rb: Any
+    arrays: Any
+    margin: float
+    max_iter: int
+    min_step: float
+    params: dict
+    kernel: Any
+    mode: int
+    knots: np.ndarray
+    consts: np.ndarray
+    groups: int
+    problem_head: tuple
+    idle: tuple
+
+
+def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
+             max_time_s) -> _Setup:
+    """Every check of a call, in the order errors are reported, and what the kernel takes."""
+    check_dof(scenario)
+    margin = planning_margin(scenario, clearance_m, margin)
+    check_max_iter(max_iter)
+    params = resolve_params("fuzzy-rrt", max_iter=max_iter, max_time_s=max_time_s,
+                            min_step_deg=min_step_deg)
+    rb = _resolve_rulebook(rulebook)
+    check_rulebook_fits(rb, scenario)
+    knots, consts = rb.compiled
+    mode = kernel_mode(rb)
+    a = scenario_arrays(scenario)
+    groups = fis_groups(rb, scenario)
+    head = tuple(a.problem(margin))[:-1]  # all but the work counter, fresh per call
+    return _Setup(rb, a, margin, int(max_iter), float(min_step_deg), params, entry_for(mode),
+                  mode, knots, consts, groups, head,
+                  tuple(idle_trace(a.dof, knots.shape[0], groups)))
+
+
+def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
+               clearance_m) -> _Setup:
+    """:func:`_prepare`, remembered per scenario object and settings while the rulebook
+    resolves to the same object (a call without a time budget or a trace)."""
+    key = ("fuzzy-rrt", id(scenario), rulebook_token(rulebook), exact(max_iter),
+           exact(min_step_deg), exact(margin), exact(clearance_m))
+    hit = lookup(key, scenario)
+    if hit is not None and _resolve_rulebook(rulebook) is hit.rb:
+        return hit
+    setup = _prepare(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m, None)
+    remember(key, scenario, setup)
+    return setup
+
+
+#: The stop flag of a call without a time budget: kernels only read it, nothing raises it.
+_NEVER_STOPPED = np.zeros(1, dtype=np.int64)
 
 
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,
@@ -300,59 +360,56 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     wall-clock budget ``max_time_s`` ends the run). ``clearance_m``/``margin`` as for
     :func:`~xfuzzy_rrt.planners.rrt.plan_rrt`.
     """
-    check_dof(scenario)
-    margin = planning_margin(scenario, clearance_m, margin)
-    check_max_iter(max_iter)
-    params = resolve_params("fuzzy-rrt", max_iter=max_iter, max_time_s=max_time_s,
-                            min_step_deg=min_step_deg)
-    rb = _resolve_rulebook(rulebook)
-    check_rulebook_fits(rb, scenario)
-    knots, consts = rb.compiled
-    mode = kernel_mode(rb)
-    kernel = entry_for(mode)
-    a = scenario_arrays(scenario)
-    problem = a.problem(margin)
-    tree = empty_tree(int(max_iter) + 2, a.limits_deg)
-    groups = fis_groups(rb, scenario)
-    buffers = (make_trace(int(max_iter), a.dof, knots.shape[0], groups) if trace
-               else idle_trace(a.dof, knots.shape[0], groups))
-    if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
-        meta0 = tree.meta.copy()
-        kernel(tuple(problem), tuple(tree), int(seed), 0, knots, consts, mode,
-               float(min_step_deg), np.zeros(1, dtype=np.int64), bool(trace), tuple(buffers))
-        reset_tree(tree, meta0)
-        problem.work[0] = 0
-    with StopFlag(max_time_s) as flag:
-        t0 = time.perf_counter()
-        ok, iterations, last = kernel(tuple(problem), tuple(tree), int(seed), int(max_iter),
-                                      knots, consts, mode, float(min_step_deg), flag.array,
-                                      bool(trace), tuple(buffers))
-        wall = time.perf_counter() - t0
-    n = int(tree.meta[0])
-    path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, a.dof))
-    # certifies the path (found -> success)
-    from xfuzzy_rrt.planners.result import certified_result, replace_result
-
-    recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
-                "bounds": rb.bounds_mode, "min_step_deg": float(min_step_deg),
+    if trace or max_time_s is not None:
+        setup = _prepare(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
+                         max_time_s)
+    else:
+        setup = _setup_for(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m)
+    rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
+    knots, consts, mode, kernel = setup.knots, setup.consts, setup.mode, setup.kernel
+    problem = (*setup.problem_head, new_work_counter())
+    tree = empty_tree(max_iter + 2, a.limits_deg)
+    buffers = (tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace
+               else setup.idle)
+    recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
+                "bounds": rb.bounds_mode, "min_step_deg": setup.min_step,
                 "margin_m": float(margin)}
-    if max_time_s is not None:
-        recorded["max_time_s"] = float(params["max_time_s"])
-        recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
+    if max_time_s is None:
+        t0 = time.perf_counter()
+        ok, iterations, last = kernel(problem, tuple(tree), int(seed), max_iter, knots, consts,
+                                      mode, setup.min_step, _NEVER_STOPPED, bool(trace),
+                                      buffers)
+        wall = time.perf_counter() - t0
+    else:  # the budget is for planning: compile (or load) the kernel first
+        meta0 = tree.meta.copy()
+        kernel(problem, tuple(tree), int(seed), 0, knots, consts, mode, setup.min_step,
+               np.zeros(1, dtype=np.int64), bool(trace), buffers)
+        reset_tree(tree, meta0)
+        problem[-1][0] = 0
+        with StopFlag(max_time_s) as flag:
+            t0 = time.perf_counter()
+            ok, iterations, last = kernel(problem, tuple(tree), int(seed), max_iter, knots,
+                                          consts, mode, setup.min_step, flag.array,
+                                          bool(trace), buffers)
+            wall = time.perf_counter() - t0
+        recorded["max_time_s"] = float(setup.params["max_time_s"])
+        recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
+    n = int(tree.meta[0])
+    nodes, parents, path, cost, within = finish_tree_run(tree.nodes, tree.parent, n,
+                                                         last if ok else -1, a.limits_deg)
+    # certifies the path (found -> success)
     result = certified_result(
-        a, margin, bool(ok), edges_certified=True, scenario=scenario.name, planner="fuzzy-rrt",
-        planner_used="fuzzy-rrt",
-        seed=int(seed),
-        iterations=int(iterations), nodes=n,
-        cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
-        tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
-        work=int(problem.work[0] + tree.meta[NN_VISITS]),
+        a, margin, bool(ok), edges_certified=True, within_limits=within,
+        scenario=scenario.name, planner="fuzzy-rrt", planner_used="fuzzy-rrt", seed=int(seed),
+        iterations=int(iterations), nodes=n, cost_deg=cost if ok else None, wall_s=wall,
+        path_deg=path, tree_nodes_deg=nodes, tree_parent=parents,
+        work=int(problem[-1][0] + tree.meta[NN_VISITS]),
         rulebook=rb.name, rulebook_sha256=rb.sha256, params=recorded,
     )
     if trace:
         from xfuzzy_rrt.planners.trace import trace_frame
 
-        frame = trace_frame(buffers, int(iterations), tree.nodes[:n], tree.parent[:n], last, rb,
-                            float(min_step_deg), groups)
+        frame = trace_frame(TraceArrays(*buffers), int(iterations), tree.nodes[:n],
+                            tree.parent[:n], last, rb, setup.min_step, setup.groups)
         result = replace_result(result, trace=frame)
     return result

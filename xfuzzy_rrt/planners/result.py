@@ -69,6 +69,123 @@ def path_cost_deg(path_deg: np.ndarray) -> float:
     return float(np.add.reduce(np.sqrt(np.add.reduce(d * d, axis=1)), axis=0))
 
 
+@nb.njit(cache=True, nogil=True)
+def _block_sum(a, lo, n):
+    """NumPy's pairwise summation of ``a[lo:lo + n]`` for ``n <= 128``: sequential below 8
+    terms, else eight running sums combined as a balanced tree, then the remainder."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    m = n - n % 8
+    while i < m:
+        k = lo + i
+        r0 += a[k]
+        r1 += a[k + 1]
+        r2 += a[k + 2]
+        r3 += a[k + 3]
+        r4 += a[k + 4]
+        r5 += a[k + 5]
+        r6 += a[k + 6]
+        r7 += a[k + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@nb.njit(cache=True, nogil=True)
+def _pairwise_sum(a, lo, n):
+    """``np.add.reduce(a[lo:lo + n])`` bit for bit: NumPy halves a sum of more than 128 terms
+    at a multiple of 8 and adds the halves' sums (left + right). The same tree, walked with an
+    explicit stack (a recursive numba function crashes when loaded from its cache)."""
+    if n <= 128:
+        return _block_sum(a, lo, n)
+    los = np.empty(64, dtype=np.int64)
+    ns = np.empty(64, dtype=np.int64)
+    left = np.empty(64)
+    has_left = np.zeros(64, dtype=np.bool_)
+    top = 0
+    los[0] = lo
+    ns[0] = n
+    while True:
+        if ns[top] > 128:  # descend into the left half
+            half = ns[top] // 2
+            half -= half % 8
+            has_left[top] = False
+            los[top + 1] = los[top]
+            ns[top + 1] = half
+            top += 1
+            continue
+        v = _block_sum(a, los[top], ns[top])
+        while True:  # hand v up until a frame still needs its right half
+            if top == 0:
+                return v
+            top -= 1
+            if has_left[top]:
+                v = left[top] + v
+                continue
+            left[top] = v
+            has_left[top] = True
+            half = ns[top] // 2
+            half -= half % 8
+            los[top + 1] = los[top] + half
+            ns[top + 1] = ns[top] - half
+            top += 1
+            break
+
+
+@nb.njit(cache=True, nogil=True)
+def path_cost_compiled(path):
+    """:func:`path_cost_deg` inside compiled code, the same float bit for bit (the same
+    differences, squares and pairwise sums; ``tests/test_plan_overhead.py`` compares them)."""
+    k, dof = path.shape
+    if k < 2:
+        return 0.0
+    seg = np.empty(k - 1)
+    sq = np.empty(dof)
+    for i in range(k - 1):
+        for j in range(dof):
+            d = path[i + 1, j] - path[i, j]
+            sq[j] = d * d
+        seg[i] = np.sqrt(_pairwise_sum(sq, 0, dof))
+    return _pairwise_sum(seg, 0, k - 1)
+
+
+@nb.njit(cache=True, nogil=True)
+def finish_tree_run(nodes, parent, n, last, limits):
+    """What a result keeps of a tree planner's run, in one compiled call: copies of the first
+    ``n`` nodes and parents, the path from the root to node ``last`` (none when ``last < 0``),
+    its cost (:func:`path_cost_compiled`), and whether every vertex is finite and within
+    ``limits`` (:func:`_vertices_within`, the re-check :func:`certified_result` makes of a
+    kernel's path). Why one call: six NumPy and two compiled calls cost a short plan more
+    than its search (``benchmarks/overhead.py``)."""
+    dof = nodes.shape[1]
+    tree_nodes = nodes[:n].copy()
+    tree_parent = parent[:n].copy()
+    k = 0
+    i = last
+    while i >= 0:
+        k += 1
+        i = parent[i]
+    path = np.empty((k, dof), dtype=np.float64)
+    i = last
+    j = k - 1
+    while i >= 0:
+        for d in range(dof):
+            path[j, d] = nodes[i, d]
+        j -= 1
+        i = parent[i]
+    within = k > 0 and _vertices_within(path, limits)
+    return tree_nodes, tree_parent, path, path_cost_compiled(path), within
+
+
 class _Pending:
     """The "not measured yet" marker; pickles as a reference to the one instance."""
 
@@ -208,6 +325,50 @@ def _vertices_within(path, limits):
     return True
 
 
+def _field_defaults() -> dict[str, Any]:
+    """The instance dictionary of a certified, not yet measured :class:`PlanResult` before its
+    caller's fields go in: every field's default, then the certified state."""
+    out = {}
+    for f in dataclasses.fields(PlanResult):
+        slot = "_" + f.name if isinstance(PlanResult.__dict__.get(f.name), _Measured) else f.name
+        if f.default is not dataclasses.MISSING:
+            out[slot] = f.default
+    out.update(found=True, certified=True, violation=None, _min_clearance_m=_PENDING,
+               _penetration_m=_PENDING)
+    return out
+
+
+_CERTIFIED_DEFAULTS: dict[str, Any] | None = None
+#: Fields without a default (``__init__`` refuses a call without them).
+_REQUIRED = frozenset(f.name for f in dataclasses.fields(PlanResult)
+                      if f.default is dataclasses.MISSING
+                      and f.default_factory is dataclasses.MISSING)
+#: The fields a :func:`_certified` caller may pass: the required ones, ``params`` (it must:
+#: its default is a fresh dict) and these; the rest keep their defaults or the certified state.
+_FAST_FIELDS = _REQUIRED | {"params", "rulebook", "rulebook_sha256", "trace", "work",
+                            "certify_work", "planner_used"}
+
+
+def _certified(fields: dict[str, Any]) -> PlanResult:
+    """``PlanResult(found=True, certified=True, min_clearance_m=<pending>,
+    penetration_m=<pending>, violation=None, **fields)`` without the frozen dataclass's
+    ``__init__`` (one ``object.__setattr__`` per field: ~7 us, a tenth of a short plan's
+    budget). The same instance dictionary, entry for entry (``tests/test_plan_overhead.py``
+    compares the two); any other set of fields goes through ``__init__``."""
+    global _CERTIFIED_DEFAULTS
+    keys = fields.keys()
+    if not (_REQUIRED <= keys and "params" in keys and keys <= _FAST_FIELDS):
+        return PlanResult(found=True, certified=True, min_clearance_m=_PENDING,
+                          penetration_m=_PENDING, violation=None, **fields)
+    if _CERTIFIED_DEFAULTS is None:
+        _CERTIFIED_DEFAULTS = _field_defaults()
+    result = object.__new__(PlanResult)
+    d = result.__dict__
+    d.update(_CERTIFIED_DEFAULTS)
+    d.update(fields)
+    return result
+
+
 _path_check = None
 
 
@@ -222,7 +383,7 @@ def _path_check_module():
 
 
 def certified_result(arrays, margin: float, found: bool, edges_certified: bool = False,
-                     **fields: Any) -> PlanResult:
+                     within_limits: bool | None = None, **fields: Any) -> PlanResult:
     """A :class:`PlanResult` whose path (``fields["path_deg"]``) has been certified.
 
     Every planner ends here, so ``found``/``certified``/``min_clearance_m`` mean the same for
@@ -234,18 +395,20 @@ def certified_result(arrays, margin: float, found: bool, edges_certified: bool =
     parent to child on the very same floats (our RRT and Fuzzy-RRT kernels). Running
     ``edge_free`` again would return the same verdicts, so only the vertices' joint limits are
     re-checked: no certification work is done twice. A certified path's exact clearance is
-    measured on first access (module docstring).
+    measured on first access (module docstring). ``within_limits``: that re-check's verdict
+    when the caller already made it on this very path (:func:`finish_tree_run`).
     """
     path = np.asarray(fields["path_deg"], dtype=np.float64)
     if not found or path.size == 0:
         return PlanResult(found=bool(found) and path.size > 0, **fields)
     checks = _path_check_module()
     if edges_certified and path.ndim == 2 and path.shape[0] >= 2 and path.shape[1] == \
-            arrays.limits_deg.shape[0] and _vertices_within(
-                np.ascontiguousarray(path), np.ascontiguousarray(arrays.limits_deg,
-                                                                 dtype=np.float64)):
-        result = PlanResult(found=True, certified=True, min_clearance_m=_PENDING,
-                            penetration_m=_PENDING, violation=None, **fields)
+            arrays.limits_deg.shape[0] and (within_limits if within_limits is not None else
+                                            _vertices_within(np.ascontiguousarray(path),
+                                                             np.ascontiguousarray(
+                                                                 arrays.limits_deg,
+                                                                 dtype=np.float64))):
+        result = _certified(fields)
         result.__dict__["_measurement"] = functools.partial(checks.path_min_clearance, arrays,
                                                             path, float(margin))
         return result

@@ -12,21 +12,24 @@ Fuzzy-RRT: every sample counts, accepted or not.
 from __future__ import annotations
 
 import time
+from typing import Any, NamedTuple
 
 import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.geometry.clearance import planning_margin
-from xfuzzy_rrt.geometry.problem import Problem
+from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
 from xfuzzy_rrt.planners.extend import extend
 from xfuzzy_rrt.planners.params import default, resolve_params
-from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, path_cost_deg
+from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
+                                         finish_tree_run)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import empty_tree, scenario_arrays
-from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, extract_path, nearest, reset_tree
+from xfuzzy_rrt.planners.setup_memo import exact, lookup, remember
+from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, nearest, reset_tree
 
 DEFAULT_STEP_DEG = default("rrt", "step_deg")
 DEFAULT_GOAL_BIAS = default("rrt", "goal_bias")
@@ -71,6 +74,48 @@ def rrt_entry(p, t, seed, max_iter, step, goal_bias, stop):
     return rrt_kernel(Problem(*p), TreeArrays(*t), seed, max_iter, step, goal_bias, stop)
 
 
+class _Setup(NamedTuple):
+    """What an RRT call checks and builds before its kernel (see
+    :mod:`xfuzzy_rrt.planners.setup_memo`): the same for every seed."""
+
+    arrays: Any
+    margin: float
+    params: dict
+    problem_head: tuple
+    recorded: dict
+
+
+def _prepare(scenario: Scenario, max_iter, step_deg, goal_bias, margin, clearance_m,
+             max_time_s) -> _Setup:
+    """Every check of a call, in the order errors are reported, and what the kernel takes."""
+    check_dof(scenario)
+    margin = planning_margin(scenario, clearance_m, margin)
+    check_max_iter(max_iter)
+    params = resolve_params("rrt", max_iter=max_iter, max_time_s=max_time_s,
+                            step_deg=step_deg, goal_bias=goal_bias)
+    a = scenario_arrays(scenario)
+    recorded = {"step_deg": float(params["step_deg"]), "goal_bias": float(params["goal_bias"]),
+                "max_iter": int(params["max_iter"]), "margin_m": float(margin)}
+    return _Setup(a, margin, params, tuple(a.problem(margin))[:-1], recorded)
+
+
+def _setup_for(scenario: Scenario, max_iter, step_deg, goal_bias, margin,
+               clearance_m) -> _Setup:
+    """:func:`_prepare`, remembered per scenario object and settings (no time budget)."""
+    key = ("rrt", id(scenario), exact(max_iter), exact(step_deg), exact(goal_bias),
+           exact(margin), exact(clearance_m))
+    hit = lookup(key, scenario)
+    if hit is not None:
+        return hit
+    setup = _prepare(scenario, max_iter, step_deg, goal_bias, margin, clearance_m, None)
+    remember(key, scenario, setup)
+    return setup
+
+
+#: The stop flag of a call without a time budget: the kernel only reads it.
+_NEVER_STOPPED = np.zeros(1, dtype=np.int64)
+
+
 def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER,
              step_deg: float = DEFAULT_STEP_DEG, goal_bias: float = DEFAULT_GOAL_BIAS,
              margin: float | None = None, clearance_m: float | None = None,
@@ -81,41 +126,41 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
     ``clearance_m``: the certified clearance (m; default the scenario's ``clearance_m``, else
     0); ``margin``: an explicit kernel margin instead (see ``geometry/clearance.py``).
     """
-    check_dof(scenario)
-    margin = planning_margin(scenario, clearance_m, margin)
-    check_max_iter(max_iter)
-    params = resolve_params("rrt", max_iter=max_iter, max_time_s=max_time_s,
-                            step_deg=step_deg, goal_bias=goal_bias)
-    max_iter = params["max_iter"]
-    a = scenario_arrays(scenario)
-    problem = a.problem(margin)
-    tree = empty_tree(int(max_iter) + 2, a.limits_deg)
-    args = (float(params["step_deg"]), float(params["goal_bias"]))
-    if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
-        meta0 = tree.meta.copy()
-        rrt_entry(tuple(problem), tuple(tree), int(seed), 0, *args, np.zeros(1, dtype=np.int64))
-        reset_tree(tree, meta0)
-        problem.work[0] = 0
-    with StopFlag(max_time_s) as flag:
+    if max_time_s is None:
+        setup = _setup_for(scenario, max_iter, step_deg, goal_bias, margin, clearance_m)
+    else:
+        setup = _prepare(scenario, max_iter, step_deg, goal_bias, margin, clearance_m,
+                         max_time_s)
+    a, margin, params = setup.arrays, setup.margin, setup.params
+    max_iter = int(params["max_iter"])
+    problem = (*setup.problem_head, new_work_counter())
+    tree = empty_tree(max_iter + 2, a.limits_deg)
+    step, bias = float(params["step_deg"]), float(params["goal_bias"])
+    recorded = dict(setup.recorded)
+    if max_time_s is None:
         t0 = time.perf_counter()
-        ok, iterations, last = rrt_entry(tuple(problem), tuple(tree), int(seed), int(max_iter),
-                                         *args,
-                                          flag.array)
+        ok, iterations, last = rrt_entry(problem, tuple(tree), int(seed), max_iter, step, bias,
+                                         _NEVER_STOPPED)
         wall = time.perf_counter() - t0
-    n = int(tree.meta[0])
-    path = extract_path(tree.nodes, tree.parent, last) if ok else np.zeros((0, a.dof))
-    recorded = {"step_deg": float(params["step_deg"]), "goal_bias": float(params["goal_bias"]),
-                "max_iter": int(max_iter), "margin_m": float(margin)}
-    if max_time_s is not None:
+    else:  # the budget is for planning: compile (or load) the kernel first
+        meta0 = tree.meta.copy()
+        rrt_entry(problem, tuple(tree), int(seed), 0, step, bias, np.zeros(1, dtype=np.int64))
+        reset_tree(tree, meta0)
+        problem[-1][0] = 0
+        with StopFlag(max_time_s) as flag:
+            t0 = time.perf_counter()
+            ok, iterations, last = rrt_entry(problem, tuple(tree), int(seed), max_iter, step,
+                                             bias, flag.array)
+            wall = time.perf_counter() - t0
         recorded["max_time_s"] = float(params["max_time_s"])
-        recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), int(max_iter), flag)
+        recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
+    n = int(tree.meta[0])
+    nodes, parents, path, cost, within = finish_tree_run(tree.nodes, tree.parent, n,
+                                                         last if ok else -1, a.limits_deg)
     return certified_result(
-        a, margin, bool(ok), edges_certified=True, scenario=scenario.name, planner="rrt",
-        planner_used="rrt",
-        seed=int(seed),
-        iterations=int(iterations), nodes=n,
-        cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
-        tree_nodes_deg=tree.nodes[:n].copy(), tree_parent=tree.parent[:n].copy(),
-        work=int(problem.work[0] + tree.meta[NN_VISITS]),
-        params=recorded,
+        a, margin, bool(ok), edges_certified=True, within_limits=within,
+        scenario=scenario.name, planner="rrt", planner_used="rrt", seed=int(seed),
+        iterations=int(iterations), nodes=n, cost_deg=cost if ok else None, wall_s=wall,
+        path_deg=path, tree_nodes_deg=nodes, tree_parent=parents,
+        work=int(problem[-1][0] + tree.meta[NN_VISITS]), params=recorded,
     )

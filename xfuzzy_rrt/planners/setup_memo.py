@@ -1,0 +1,94 @@
+"""Validated plan set-ups remembered between calls.
+
+Why: on a 2-DOF problem a planner's kernel often runs for well under 0.1 ms, and what a call
+checks and builds before it (the arm's DOF, the clearance against the start and goal, every
+parameter's range, the rulebook against the arms, the kernel's mode, its problem record) costs
+tens of microseconds of Python. A library loop, a benchmark or ``evaluate`` plans the same
+scenario object with the same settings many times (seeds), so the result of those checks is
+remembered, keyed on exactly what the checks read.
+
+When a remembered set-up is used:
+
+- the same scenario *object* (scenarios are frozen), found through a weak reference, so a
+  recycled ``id`` never matches a dead scenario's entry;
+- the same settings, equal in value *and* type (``True`` is not ``1``, ``-0.0`` is not
+  ``0.0``, ``1`` is not ``1.0``): :func:`exact` builds the key;
+- the caller checks that the rulebook it resolves now is the very object the set-up was
+  built for (an edited rulebook directory loads as a new object: ``load_rulebook_cached``).
+
+Errors are never remembered: only a set-up whose checks all passed is stored, so a call with
+bad inputs runs the checks and raises the same one-line error every time. The memo is bounded
+(:data:`MAX_ENTRIES`, oldest dropped first) and shared by threads; set-ups are immutable, and
+what a call mutates (the tree, the work counter) is never part of one.
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+from typing import Any, Hashable
+
+#: Set-ups kept (each a few small arrays and references to shared, immutable objects).
+MAX_ENTRIES = 128
+_memo: dict[Hashable, tuple[Any, Any]] = {}
+
+
+class _Unhashable:
+    """A key part that equals nothing else: a setting that cannot be a key never hits."""
+
+    __slots__ = ()
+
+
+def exact(value: Any) -> Hashable:
+    """A key for ``value`` that tells apart values Python calls equal but the checks do not:
+    its type goes in, and a float's sign (``-0.0`` and ``0.0`` print differently in a result's
+    ``params``). NaN keys never match (NaN is never equal to itself, and a NaN setting never
+    passes the checks anyway)."""
+    if value is None:
+        return None
+    kind = type(value)
+    if kind is float:
+        return kind, value, math.copysign(1.0, value)
+    try:
+        hash(value)
+    except TypeError:
+        return _Unhashable()
+    return kind, value
+
+
+def rulebook_token(rulebook: Any) -> Hashable:
+    """A key for the ``rulebook`` argument as given: ``None``, a path (as a string) or a loaded
+    rulebook's identity. Only narrows the search: the caller still compares the resolved
+    rulebook object with the set-up's."""
+    if rulebook is None or type(rulebook) is str:
+        return rulebook
+    if hasattr(rulebook, "__fspath__"):
+        return "path", rulebook.__fspath__()
+    return "object", id(rulebook)
+
+
+def lookup(key: Hashable, scenario: Any) -> Any | None:
+    """The set-up remembered for ``key`` if it was made for this very ``scenario``, else None."""
+    hit = _memo.get(key)
+    if hit is None or hit[0]() is not scenario:
+        return None
+    return hit[1]
+
+
+def remember(key: Hashable, scenario: Any, setup: Any) -> None:
+    """Keep ``setup`` for ``key`` (nothing is kept for a scenario without weak references)."""
+    try:
+        ref = weakref.ref(scenario)
+    except TypeError:
+        return
+    _memo[key] = (ref, setup)
+    while len(_memo) > MAX_ENTRIES:
+        try:
+            del _memo[next(iter(_memo))]
+        except (KeyError, StopIteration, RuntimeError):  # another thread trimmed it first
+            break
+
+
+def clear() -> None:
+    """Forget every set-up (tests; nothing else needs it)."""
+    _memo.clear()

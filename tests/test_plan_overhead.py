@@ -267,3 +267,23 @@ def test_a_remembered_set_up_follows_an_edited_rulebook_and_a_new_scenario_objec
     plan_fuzzy_rrt(copy, root, seed=2)
     assert len(setup_memo._memo) == key_count + 1
     assert setup_memo.lookup(("no such key",), s) is None
+
+
+def test_relabelling_a_result_copies_every_field_and_keeps_the_measurement_pending(
+        scenarios, monkeypatch):
+    calls = _count_measurements(monkeypatch)
+    r = plan_scenario(scenarios[0], "rrt", seed=2)
+    assert r.success and calls == []
+    fast = replace_result(r, planner="rrt:tuned", planner_used="rrt:tuned",
+                          params={**r.params, "tuned": True})
+    assert calls == [] and fast.__dict__["_min_clearance_m"] is _PENDING
+    slow = dataclasses.replace(r, planner="rrt:tuned", planner_used="rrt:tuned",
+                               params={**r.params, "tuned": True})  # measures r, eagerly
+    assert len(calls) == 1 and type(fast) is PlanResult and fast.planner == "rrt:tuned"
+    for f in dataclasses.fields(PlanResult):
+        a, b = getattr(fast, f.name), getattr(slow, f.name)
+        assert a is b or np.array_equal(a, b) or a == b, f.name
+    assert len(calls) == 2  # the copy measured once, on its own
+    assert fast.params["tuned"] and "tuned" not in r.params
+    with pytest.raises(ValueError):  # anything else still goes through __init__'s checks
+        replace_result(r, found=False)

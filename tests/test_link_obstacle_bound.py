@@ -101,6 +101,25 @@ def test_an_edge_check_asked_for_less_than_the_clearance_certifies_nothing(links
     assert not edge_free(P, qa, qb, CERT_MARGIN_M)
 
 
+@pytest.mark.parametrize("links", [(0.17, 0.13), (0.12, 0.1, 0.08)])
+@pytest.mark.parametrize("end", ["start", "goal"])
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+def test_an_edge_with_a_nan_outer_joint_angle_is_never_certified(links, end, bad):
+    """A NaN (or infinite) outer joint angle puts the outer link's far end nowhere: its
+    distance must count as touching, so the edge is refused, whichever end carries it. (The
+    survivor of mutation testing in the two-link path's ``not c1 < inf`` guard is equivalent:
+    such a link measures ``-radius``, never ``inf`` or NaN, and an all-NaN obstacle list trips
+    the first link's guard before it; this pins what makes it so.)"""
+    links = np.array(links)
+    n = links.shape[0]
+    box = np.array([[1.0, 0.25, -0.05, 0.35, 0.05]])
+    P = single_arm_problem(links, np.zeros(2), 0.005, box, np.tile([-180.0, 180.0], (n, 1)))
+    qa, qb = np.zeros(n), np.zeros(n)
+    qa[0], qb[0] = 90.0, 80.0
+    (qa if end == "start" else qb)[n - 1] = bad
+    assert not edge_free(P, qa, qb, CERT_MARGIN_M)
+
+
 @pytest.mark.parametrize("links", [(0.3,), (0.17, 0.13), (0.12, 0.1, 0.08)])
 def test_an_obstacle_with_a_nan_coordinate_is_never_certified_past(links):
     """A NaN clearance (a NaN obstacle row) is not a free stop, on every path of the check."""

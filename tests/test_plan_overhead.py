@@ -287,3 +287,42 @@ def test_relabelling_a_result_copies_every_field_and_keeps_the_measurement_pendi
     assert fast.params["tuned"] and "tuned" not in r.params
     with pytest.raises(ValueError):  # anything else still goes through __init__'s checks
         replace_result(r, found=False)
+
+
+def _random_tree(rng, n, dof):
+    nodes = rng.uniform(-180.0, 180.0, (n, dof))
+    parent = np.array([-1] + [int(rng.integers(0, i)) for i in range(1, n)], dtype=np.int64)
+    return nodes, parent
+
+
+def _path_to(nodes, parent, last):
+    rows = []
+    while last >= 0:
+        rows.append(nodes[last])
+        last = parent[last]
+    return np.array(rows[::-1])
+
+
+def test_finishing_a_connect_run_joins_both_trees_as_numpy_would():
+    from xfuzzy_rrt.planners.connect import finish_connect_run
+
+    rng = np.random.default_rng(11)
+    limits = np.tile([-180.0, 180.0], (3, 1))
+    for _ in range(30):
+        na, nb = int(rng.integers(1, 40)), int(rng.integers(1, 40))
+        A, pa = _random_tree(rng, na + 5, 3)  # spare rows past the trees' sizes are ignored
+        B, pb = _random_tree(rng, nb + 5, 3)
+        la, lb = int(rng.integers(0, na)), int(rng.integers(0, nb))
+        B[lb] = A[la]  # the junction: one configuration in both trees
+        nodes, parent, path, cost, within, same = finish_connect_run(A, pa, na, B, pb, nb, la,
+                                                                     lb, limits)
+        assert np.array_equal(nodes, np.vstack([A[:na], B[:nb]]))
+        assert np.array_equal(parent, np.concatenate([pa[:na],
+                                                      np.where(pb[:nb] >= 0, pb[:nb] + na, -1)]))
+        expected = np.vstack([_path_to(A, pa, la), _path_to(B, pb, lb)[::-1][1:]])
+        assert np.array_equal(path, expected) and same and within
+        assert cost == path_cost_deg(expected)
+        B[lb, 0] += 1.0  # trees that do not meet are reported, never joined silently
+        assert not finish_connect_run(A, pa, na, B, pb, nb, la, lb, limits)[5]
+    none = finish_connect_run(A, pa, na, B, pb, nb, -1, -1, limits)
+    assert none[2].shape == (0, 3) and not none[4] and none[5]

@@ -305,17 +305,21 @@ def default_rulebook_path() -> Path:
     return rulebooks_dir() / DEFAULT_RULEBOOK
 
 
-@functools.lru_cache(maxsize=8)
-def _default_dir_str(env: str | None) -> str:
-    return os.path.abspath(Path(env) / DEFAULT_RULEBOOK if env else
-                           _shipped_rulebooks_dir() / DEFAULT_RULEBOOK)
+@functools.lru_cache(maxsize=32)
+def _shipped_dir_str(env: str | None, name: str) -> str:
+    return os.path.abspath(Path(env) / name if env else _shipped_rulebooks_dir() / name)
+
+
+def shipped_rulebook_str(name: str = DEFAULT_RULEBOOK) -> str:
+    """``rulebooks_dir() / name`` as an absolute string, what every plan call without a
+    rulebook looks up: the environment is read on every call (it may change), the path built
+    once per value of it (a ``Path`` join and ``abspath`` cost more than the look-up's stats)."""
+    return _shipped_dir_str(os.environ.get(RULEBOOKS_ENV) or None, name)
 
 
 def default_rulebook_str() -> str:
-    """:func:`default_rulebook_path` as an absolute string, what every plan call without a
-    rulebook looks up: the environment is read on every call (it may change), the path built
-    once per value of it."""
-    return _default_dir_str(os.environ.get(RULEBOOKS_ENV) or None)
+    """:func:`default_rulebook_path` as :func:`shipped_rulebook_str` gives it."""
+    return _shipped_dir_str(os.environ.get(RULEBOOKS_ENV) or None, DEFAULT_RULEBOOK)
 
 
 def _content_key(root: Path) -> str:

@@ -65,6 +65,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Any, NamedTuple
 
 import numba as nb
 import numpy as np
@@ -91,19 +92,22 @@ from xfuzzy_rrt.planners.result import (
     GOAL_REACHED,
     NODE_IN_COLLISION,
     PlanResult,
-    path_cost_deg,
+    certified_result,
+    path_cost_compiled,
+    replace_result,
+    vertices_within,
 )
 from xfuzzy_rrt.planners.rng import seed_state
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
-from xfuzzy_rrt.geometry.problem import Problem
+from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
+from xfuzzy_rrt.planners.setup_memo import exact, lookup, remember, rulebook_token
 from xfuzzy_rrt.planners.trace_record import TraceArrays
 from xfuzzy_rrt.planners.tree import (
     NN_VISITS,
     TreeArrays,
     add_node,
-    extract_path,
     nearest,
     reset_tree,
 )
@@ -277,11 +281,11 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step
 
 def _resolve_rulebook(rulebook):
     """A loaded rulebook as given, else the (cached) directory, else the shipped default."""
-    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached, rulebooks_dir
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached, shipped_rulebook_str
 
     if rulebook is None:
-        rulebook = rulebooks_dir() / DEFAULT_RULEBOOK
-    if hasattr(rulebook, "compiled"):
+        rulebook = shipped_rulebook_str(DEFAULT_RULEBOOK)
+    elif hasattr(rulebook, "compiled"):
         return rulebook
     return load_rulebook_cached(rulebook)
 
@@ -301,11 +305,58 @@ def check_connect_rulebook(rb, scenario: Scenario) -> None:
         check_rulebook_fits(rb, scenario)
 
 
-def merged_tree(nodes_a, parent_a, nodes_b, parent_b):
-    """Both trees as one forest (start tree first; goal-tree parents shifted, its root -1)."""
-    na = nodes_a.shape[0]
-    parent = np.concatenate([parent_a, np.where(parent_b >= 0, parent_b + na, -1)])
-    return np.vstack([nodes_a, nodes_b]), parent.astype(np.int64)
+@nb.njit(cache=True, nogil=True)
+def finish_connect_run(nodes_a, parent_a, na, nodes_b, parent_b, nb_, last_a, last_b, limits):
+    """What a result keeps of a run, in one compiled call (see
+    :func:`~xfuzzy_rrt.planners.result.finish_tree_run`): the two trees as one forest (the start
+    tree first; the goal tree's parents shifted past it, its root's ``-1`` kept), the joined path
+    (the start tree's path to the junction, then the goal tree's from the junction's parent to
+    its root; none when ``last_a < 0``), its cost, whether every vertex is within ``limits``, and
+    whether the two junction nodes are the same configuration (the kernel joins trees at one
+    only)."""
+    dof = nodes_a.shape[1]
+    nodes = np.empty((na + nb_, dof), dtype=np.float64)
+    parent = np.empty(na + nb_, dtype=np.int64)
+    for i in range(na):
+        parent[i] = parent_a[i]
+        for d in range(dof):
+            nodes[i, d] = nodes_a[i, d]
+    for i in range(nb_):
+        parent[na + i] = parent_b[i] + na if parent_b[i] >= 0 else -1
+        for d in range(dof):
+            nodes[na + i, d] = nodes_b[i, d]
+    if last_a < 0:
+        return nodes, parent, np.empty((0, dof), dtype=np.float64), 0.0, False, True
+    ka = 0
+    i = last_a
+    while i >= 0:
+        ka += 1
+        i = parent_a[i]
+    kb = 0
+    i = last_b
+    while i >= 0:
+        kb += 1
+        i = parent_b[i]
+    same = True
+    for d in range(dof):
+        if nodes_a[last_a, d] != nodes_b[last_b, d]:
+            same = False
+    path = np.empty((ka + kb - 1, dof), dtype=np.float64)
+    i = last_a
+    j = ka - 1
+    while i >= 0:
+        for d in range(dof):
+            path[j, d] = nodes_a[i, d]
+        j -= 1
+        i = parent_a[i]
+    i = parent_b[last_b]
+    j = ka
+    while i >= 0:
+        for d in range(dof):
+            path[j, d] = nodes_b[i, d]
+        j += 1
+        i = parent_b[i]
+    return nodes, parent, path, path_cost_compiled(path), vertices_within(path, limits), same
 
 
 @nb.njit(cache=True, nogil=True)
@@ -318,13 +369,59 @@ def connect_entry(p, pr, ta, tb, seed, max_iter, knots, consts, scale, min_step,
                           TraceArrays(*tr), grown, connect_nodes, counts)
 
 
-def joined_path(TA, TB, last_a: int, last_b: int) -> np.ndarray:
-    """Start-tree path to the junction, then the goal-tree path from it, reversed."""
-    pa = extract_path(TA.nodes, TA.parent, last_a)
-    pb = extract_path(TB.nodes, TB.parent, last_b)
-    if not np.array_equal(pa[-1], pb[-1]):  # the kernel joins trees only at one configuration
-        raise RuntimeError("fuzzy-rrt-connect: the two trees' junction nodes differ")
-    return np.vstack([pa, pb[::-1][1:]])
+class _Setup(NamedTuple):
+    """What a Fuzzy-RRT-Connect call checks and builds before its kernel (see
+    :mod:`xfuzzy_rrt.planners.setup_memo`): the same for every seed."""
+
+    rb: Any
+    arrays: Any
+    margin: float
+    max_iter: int
+    min_step: float
+    params: dict
+    knots: np.ndarray
+    consts: np.ndarray
+    scale: float
+    forward_head: tuple
+    reverse_head: tuple
+
+
+def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
+             max_time_s) -> _Setup:
+    """Every check of a call, in the order errors are reported, and what the kernel takes."""
+    check_dof(scenario)
+    margin = planning_margin(scenario, clearance_m, margin)
+    check_max_iter(max_iter)
+    params = resolve_params("fuzzy-rrt", max_iter=max_iter, max_time_s=max_time_s,
+                            min_step_deg=min_step_deg)
+    rb = _resolve_rulebook(rulebook)
+    check_connect_rulebook(rb, scenario)
+    knots, consts = rb.compiled
+    scale = length_scale(rb.semantics, scenario.dof)
+    a = scenario_arrays(scenario)
+    problem = a.problem(margin)
+    reverse = problem._replace(start=problem.goal, goal=problem.start)
+    # all but the work counter, fresh per call and shared by both directions
+    return _Setup(rb, a, margin, int(max_iter), float(params["min_step_deg"]), params, knots,
+                  consts, scale, tuple(problem)[:-1], tuple(reverse)[:-1])
+
+
+def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
+               clearance_m) -> _Setup:
+    """:func:`_prepare`, remembered per scenario object and settings while the rulebook
+    resolves to the same object (a call without a time budget or a trace)."""
+    key = (PLANNER, id(scenario), rulebook_token(rulebook), exact(max_iter),
+           exact(min_step_deg), exact(margin), exact(clearance_m))
+    hit = lookup(key, scenario)
+    if hit is not None and _resolve_rulebook(rulebook) is hit.rb:
+        return hit
+    setup = _prepare(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m, None)
+    remember(key, scenario, setup)
+    return setup
+
+
+#: The stop flag of a call without a time budget: the kernel only reads it.
+_NEVER_STOPPED = np.zeros(1, dtype=np.int64)
 
 
 def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
@@ -339,69 +436,71 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     the problem's total number of joints. Other
     arguments as for :func:`~xfuzzy_rrt.planners.fuzzy_rrt.plan_fuzzy_rrt`.
     """
-    check_dof(scenario)
-    margin = planning_margin(scenario, clearance_m, margin)
-    check_max_iter(max_iter)
-    params = resolve_params("fuzzy-rrt", max_iter=max_iter, max_time_s=max_time_s,
-                            min_step_deg=min_step_deg)
-    min_step = float(params["min_step_deg"])
-    rb = _resolve_rulebook(rulebook)
-    check_connect_rulebook(rb, scenario)
-    knots, consts = rb.compiled
-    scale = length_scale(rb.semantics, scenario.dof)
-    a = scenario_arrays(scenario)
-    problem = a.problem(margin)
-    reverse = problem._replace(start=problem.goal, goal=problem.start)  # shares the work counter
+    if trace or max_time_s is not None:
+        setup = _prepare(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
+                         max_time_s)
+    else:
+        setup = _setup_for(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m)
+    rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
+    knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
+    work = new_work_counter()  # one count for both directions
+    problem = (*setup.forward_head, work)
+    reverse = (*setup.reverse_head, work)
     cap = tree_capacity(max_iter)
     ta = empty_tree(cap, a.limits_deg, slot=0)
     tb = empty_tree(cap, a.limits_deg, slot=1)
-    rows = int(max_iter) if trace else 1
+    rows = max_iter if trace else 1
     buffers = (make_trace(rows, a.dof, knots.shape[0], 1) if trace
                else idle_trace(a.dof, knots.shape[0], 1))
     grown = np.zeros(rows, dtype=np.int8)
     connect_nodes = np.zeros(rows, dtype=np.int64)
     counts = np.zeros(1, dtype=np.int64)
-    args = (tuple(problem), tuple(reverse), tuple(ta), tuple(tb), int(seed))
+    args = (problem, reverse, tuple(ta), tuple(tb), int(seed))
     tail = (knots, consts, scale, min_step)
 
     def run(iters, stop):
         return connect_entry(*args, int(iters), *tail, stop, bool(trace), tuple(buffers), grown,
                              connect_nodes, counts)
 
-    if max_time_s is not None:  # the budget is for planning: compile (or load) the kernel first
+    recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
+                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
+    if max_time_s is None:
+        t0 = time.perf_counter()
+        ok, iterations, last_a, last_b = run(max_iter, _NEVER_STOPPED)
+        wall = time.perf_counter() - t0
+    else:  # the budget is for planning: compile (or load) the kernel first
         meta_a, meta_b = ta.meta.copy(), tb.meta.copy()
         run(0, np.zeros(1, dtype=np.int64))
         reset_tree(ta, meta_a)
         reset_tree(tb, meta_b)
-        problem.work[0] = 0
+        work[0] = 0
         counts[0] = 0
-    with StopFlag(max_time_s) as flag:
-        t0 = time.perf_counter()
-        ok, iterations, last_a, last_b = run(max_iter, flag.array)
-        wall = time.perf_counter() - t0
+        with StopFlag(max_time_s) as flag:
+            t0 = time.perf_counter()
+            ok, iterations, last_a, last_b = run(max_iter, flag.array)
+            wall = time.perf_counter() - t0
     ok = bool(ok)
     na, nb_ = int(ta.meta[0]), int(tb.meta[0])
-    path = joined_path(ta, tb, int(last_a), int(last_b)) if ok else np.zeros((0, a.dof))
-    nodes, parent = merged_tree(ta.nodes[:na], ta.parent[:na], tb.nodes[:nb_], tb.parent[:nb_])
-    from xfuzzy_rrt.planners.result import certified_result, replace_result
-
-    recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
-                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale,
-                "extensions": int(counts[0]), "start_tree_nodes": na, "goal_tree_nodes": nb_}
+    nodes, parent, path, cost, within, same = finish_connect_run(
+        ta.nodes, ta.parent, na, tb.nodes, tb.parent, nb_, int(last_a) if ok else -1,
+        int(last_b), a.limits_deg)
+    if not same:
+        raise RuntimeError("fuzzy-rrt-connect: the two trees' junction nodes differ")
+    recorded.update(extensions=int(counts[0]), start_tree_nodes=na, goal_tree_nodes=nb_)
     if max_time_s is not None:
-        recorded["max_time_s"] = float(params["max_time_s"])
-        recorded["stopped_by"] = stopped_by(ok, int(iterations), int(max_iter), flag)
+        recorded["max_time_s"] = float(setup.params["max_time_s"])
+        recorded["stopped_by"] = stopped_by(ok, int(iterations), max_iter, flag)
     result = certified_result(
         a, margin, ok, scenario=scenario.name, planner=PLANNER, planner_used=PLANNER,
         seed=int(seed),
         iterations=int(iterations), nodes=na + nb_,
-        cost_deg=path_cost_deg(path) if ok else None, wall_s=wall, path_deg=path,
+        cost_deg=cost if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=nodes, tree_parent=parent, rulebook=rb.name,
         rulebook_sha256=rb.sha256, params=recorded,
-        work=int(problem.work[0] + ta.meta[NN_VISITS] + tb.meta[NN_VISITS]),
+        work=int(work[0] + ta.meta[NN_VISITS] + tb.meta[NN_VISITS]),
         # every path segment is a tree edge the kernel certified with edge_free at this margin
         # (the goal tree's, traversed backwards: the same set of configurations)
-        edges_certified=True,
+        edges_certified=True, within_limits=within,
     )
     if trace:
         frame = _trace_frame(buffers, grown, connect_nodes, int(iterations), nodes, parent, na,

@@ -163,7 +163,7 @@ def finish_tree_run(nodes, parent, n, last, limits):
     """What a result keeps of a tree planner's run, in one compiled call: copies of the first
     ``n`` nodes and parents, the path from the root to node ``last`` (none when ``last < 0``),
     its cost (:func:`path_cost_compiled`), and whether every vertex is finite and within
-    ``limits`` (:func:`_vertices_within`, the re-check :func:`certified_result` makes of a
+    ``limits`` (:func:`vertices_within`, the re-check :func:`certified_result` makes of a
     kernel's path). Why one call: six NumPy and two compiled calls cost a short plan more
     than its search (``benchmarks/overhead.py``)."""
     dof = nodes.shape[1]
@@ -182,7 +182,7 @@ def finish_tree_run(nodes, parent, n, last, limits):
             path[j, d] = nodes[i, d]
         j -= 1
         i = parent[i]
-    within = k > 0 and _vertices_within(path, limits)
+    within = k > 0 and vertices_within(path, limits)
     return tree_nodes, tree_parent, path, path_cost_compiled(path), within
 
 
@@ -331,7 +331,7 @@ def replace_result(result: PlanResult, **changes: Any) -> PlanResult:
 
 
 @nb.njit(cache=True, nogil=True)
-def _vertices_within(path, limits):
+def vertices_within(path, limits):
     """Every vertex of ``path`` [k, dof] finite and within ``limits`` [dof, 2] (one compiled
     pass instead of six NumPy calls: this runs after every plan)."""
     for i in range(path.shape[0]):
@@ -421,7 +421,7 @@ def certified_result(arrays, margin: float, found: bool, edges_certified: bool =
     checks = _path_check_module()
     if edges_certified and path.ndim == 2 and path.shape[0] >= 2 and path.shape[1] == \
             arrays.limits_deg.shape[0] and (within_limits if within_limits is not None else
-                                            _vertices_within(np.ascontiguousarray(path),
+                                            vertices_within(np.ascontiguousarray(path),
                                                              np.ascontiguousarray(
                                                                  arrays.limits_deg,
                                                                  dtype=np.float64))):

@@ -4,7 +4,11 @@ A rulebook is six zero-order TSK systems over four inputs (5 terms each, 625 rul
 those inputs and outputs are is the rulebook's semantics, named in its manifest
 (``semantics = "..."``; absent means ``paper``). Every tool (parser, lint, engine arrays,
 traces, ``explain``, coverage, FLL) reads names, ranges and units from here, never from
-module constants, so a new semantics is one entry below plus its planner kernel.
+module constants, so a new semantics is one :func:`register` call plus its planner kernel.
+A semantics is also the plug-in the planner and the trainer run it through: its training
+``modes`` and the integer each passes to its compiled ``kernel``, its training ``population``
+evaluation, and ``per_arm`` (one fuzzy evaluation per arm or one for all arms: its DOF, and
+the trace's column groups); nothing else switches on a semantics' name to choose them.
 
 ``paper`` — the paper's (Shankar et al.) four workspace inputs and a joint box: exactly the
 conventions of SPEC.md. It cannot generalise: workspace angles do not say which way a joint

@@ -42,6 +42,9 @@ def run_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_st
     ``knots_b`` [P, n_out, 4, 5] and ``consts_b`` [P, n_out, 625] are decoded individuals;
     ``T`` is one preallocated tree (:func:`~xfuzzy_rrt.planners.tree.make_tree`), emptied
     before each run; ``TR`` 1-row trace buffers the kernels never touch (``record`` is off).
+    ``bounds_mode`` is the integer the semantics' kernel takes (``Semantics.kernel_mode``;
+    compiled code cannot take the semantics object, so the choice of loop stays this one
+    integer test per run).
     """
     n_ind = knots_b.shape[0]
     n_seeds = seeds.shape[0]

@@ -361,7 +361,7 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
         if seed_ is None:
             continue
         example = by_run[(scen, planner, seed_)]
-        if planner in jobs_rb:
+        if planner in jobs_rb and registry.lookup(planner).traces:
             # Re-run the example with tracing (deterministic: the same run, plus its trace)
             # so the report can show what the fuzzy systems decided.
             example = plan_scenario(by_name[scen], planner=planner, rulebook=jobs_rb[planner],

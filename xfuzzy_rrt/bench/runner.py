@@ -50,6 +50,7 @@ import pandas as pd
 from xfuzzy_rrt.bench.summary import ratio_table, summarise
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import Scenario
+from xfuzzy_rrt.planners import registry
 from xfuzzy_rrt.planners.api import plan_scenario
 from xfuzzy_rrt.planners.result import PlanResult, path_cost_deg
 
@@ -119,13 +120,13 @@ def load_rulebooks(planners: list[str], rulebook=None) -> tuple[dict[str, Any], 
     broken rulebook fails here, before any planning.
     """
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
-    from xfuzzy_rrt.planners.api import RULEBOOK_KINDS, default_rulebook_dir, parse_planner
+    from xfuzzy_rrt.planners.api import default_rulebook_dir, parse_planner
 
     books: dict[str, Any] = {}
     dirs: dict[str, str] = {}
     for label in planners:
         spec = parse_planner(label, "--planners")
-        if spec.kind not in RULEBOOK_KINDS:
+        if not spec.planner.takes_rulebook:
             continue
         source = spec.rulebook_dir if spec.rulebook_dir is not None else rulebook
         if source is None:
@@ -146,7 +147,7 @@ def _one_run(job: _Job) -> tuple[PlanResult, dict[str, Any]]:
     time_total = time.perf_counter() - t0
     params = r.params if isinstance(r.params, dict) else {}
     time_first = params.get("time_first_s")
-    first_solution = (job.planner in ("rrt", "rrt:tuned") or job.planner.startswith("fuzzy-rrt")
+    first_solution = (registry.lookup(job.planner).first_solution
                       or params.get("stopped_by") == "solution")
     if time_first is None and r.found and first_solution:
         time_first = r.wall_s  # the run stopped at its first solution
@@ -185,22 +186,18 @@ def check_pairs(scenarios: list[Scenario], rulebooks: dict[str, Any]) -> None:
 
     ``rulebooks``: label -> what its jobs get (:func:`job_rulebooks`); the shipped default of
     plain ``fuzzy-rrt`` fits every problem by construction, a ``fuzzy-rrt-connect`` label is
-    checked as Fuzzy-RRT-Connect checks it (a DOF-free rulebook fits every arm)."""
-    from xfuzzy_rrt.planners.api import ShippedDefault, parse_planner
+    checked as Fuzzy-RRT-Connect checks it (a DOF-free rulebook fits every arm): each label's
+    registration's ``fits`` (:mod:`xfuzzy_rrt.planners.registry`)."""
+    from xfuzzy_rrt.planners.api import ShippedDefault
     from xfuzzy_rrt.planners.checks import check_dof
-    from xfuzzy_rrt.planners.connect import check_connect_rulebook
-    from xfuzzy_rrt.planners.fuzzy_rrt import check_rulebook_fits
 
-    kinds = {label: parse_planner(label).kind for label in rulebooks}
+    fits = {label: registry.lookup(label).fits_fn for label in rulebooks}
     for s in scenarios:
         check_dof(s)
         for label, rb in rulebooks.items():
-            if isinstance(rb, ShippedDefault):
+            if isinstance(rb, ShippedDefault) or fits[label] is None:
                 continue
-            if kinds[label] == "fuzzy-rrt-connect":
-                check_connect_rulebook(rb, s)
-            else:
-                check_rulebook_fits(rb, s)
+            fits[label](rb, s)
 
 
 def job_rulebooks(planners: list[str], rulebooks: dict[str, Any], rulebook=None) -> dict[str, Any]:
@@ -364,7 +361,7 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
         if seed_ is None:
             continue
         example = by_run[(scen, planner, seed_)]
-        if planner in jobs_rb:
+        if planner in jobs_rb and registry.lookup(planner).traces:
             # Re-run the example with tracing (deterministic: the same run, plus its trace)
             # so the report can show what the fuzzy systems decided.
             example = plan_scenario(by_name[scen], planner=planner, rulebook=jobs_rb[planner],

@@ -9,6 +9,11 @@ from typing import Optional
 import typer
 
 from xfuzzy_rrt.cli.common import check_seed_option
+from xfuzzy_rrt.planners import registry as _registry
+
+#: What the help says takes a rulebook / records a trace (the planner registry's exact labels).
+_RULEBOOK_PLANNERS = ", ".join(_registry.exact_labels(takes_rulebook=True))
+_TRACING_PLANNERS = ", ".join(_registry.exact_labels(traces=True))
 
 
 class PlannerName(str, enum.Enum):
@@ -20,18 +25,14 @@ def plan(
     scenario: Path = typer.Argument(..., help="Scenario TOML file."),
     planner: str = typer.Option(
         PlannerName.fuzzy_rrt.value, "--planner",
-        help="Planner: rrt, fuzzy-rrt (without --rulebook: goal-frame on one 2-joint arm, else "
-             "fuzzy-rrt-connect with goal-frame-any; the JSON's planner_used says which ran), "
-             "fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR, "
-             "fuzzy-rrt-connect[:NAME|:DIR] (two goal-frame trees; default rulebook goal-frame-any, any arm), or "
-             "ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)."),
+        help=_registry.planner_help()),
     rulebook: Optional[Path] = typer.Option(
-        None, "--rulebook", help="Rulebook directory (fuzzy-rrt, fuzzy-rrt-connect; default: the shipped default of the problem: goal-frame for one 2-joint arm, else fuzzy-rrt-connect with goal-frame-any, as the JSON's planner_used and rulebook say)."),
+        None, "--rulebook", help=f"Rulebook directory ({_RULEBOOK_PLANNERS}; default: the shipped default of the problem: goal-frame for one 2-joint arm, else fuzzy-rrt-connect with goal-frame-any, as the JSON's planner_used and rulebook say)."),
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Random seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON here (default: stdout)."),
     trace: Optional[Path] = typer.Option(
-        None, "--trace", help="Write the per-iteration trace (.parquet or .csv; fuzzy-rrt, fuzzy-rrt-connect)."),
+        None, "--trace", help=f"Write the per-iteration trace (.parquet or .csv; {_TRACING_PLANNERS})."),
     step_deg: float = typer.Option(10.0, "--step-deg", help="RRT step size in degrees."),
     goal_bias: float = typer.Option(0.05, "--goal-bias", help="RRT goal bias in [0, 1]."),
     clearance: Optional[float] = typer.Option(
@@ -45,19 +46,15 @@ def plan(
     collision-free (one line on stderr says where it penetrates and how deep).
     """
     from xfuzzy_rrt.cli.common import check_output_file, emit_json, load_scenario_warn
-    from xfuzzy_rrt.planners.api import (
-        RULEBOOK_KINDS,
-        parse_planner,
-        plan_scenario,
-        write_trace_checked,
-    )
+    from xfuzzy_rrt.planners.api import parse_planner, plan_scenario, write_trace_checked
     from xfuzzy_rrt.planners.termination import check_max_time
 
     spec = parse_planner(planner, "--planner")
-    if rulebook is not None and spec.kind not in RULEBOOK_KINDS:
+    if rulebook is not None and not spec.planner.takes_rulebook:
         from xfuzzy_rrt.errors import InputError
 
-        raise InputError("--rulebook", f"only fuzzy-rrt and fuzzy-rrt-connect plan with a "
+        takers = _registry.either(_registry.exact_labels(takes_rulebook=True), "and")
+        raise InputError("--rulebook", f"only {takers} plan with a "
                          f"rulebook; --planner {planner} would ignore it (drop --rulebook or "
                          "use --planner fuzzy-rrt)")
     if trace is not None:
@@ -67,7 +64,7 @@ def plan(
     s = load_scenario_warn(scenario)
     rulebook_dir = None
     rulebook_obj = None
-    if spec.kind in RULEBOOK_KINDS:
+    if spec.planner.takes_rulebook:
         from xfuzzy_rrt.errors import InputError
         from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
         from xfuzzy_rrt.planners.api import default_rulebook_dir, shipped_default

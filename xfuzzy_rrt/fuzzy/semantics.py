@@ -4,7 +4,11 @@ A rulebook is six zero-order TSK systems over four inputs (5 terms each, 625 rul
 those inputs and outputs are is the rulebook's semantics, named in its manifest
 (``semantics = "..."``; absent means ``paper``). Every tool (parser, lint, engine arrays,
 traces, ``explain``, coverage, FLL) reads names, ranges and units from here, never from
-module constants, so a new semantics is one entry below plus its planner kernel.
+module constants, so a new semantics is one :func:`register` call plus its planner kernel.
+A semantics is also the plug-in the planner and the trainer run it through: its training
+``modes`` and the integer each passes to its compiled ``kernel``, its training ``population``
+evaluation, and ``per_arm`` (one fuzzy evaluation per arm or one for all arms: its DOF, and
+the trace's column groups); nothing else switches on a semantics' name to choose them.
 
 ``paper`` — the paper's (Shankar et al.) four workspace inputs and a joint box: exactly the
 conventions of SPEC.md. It cannot generalise: workspace angles do not say which way a joint
@@ -53,7 +57,7 @@ Only Fuzzy-RRT-Connect (:mod:`xfuzzy_rrt.planners.connect`) plans with it so far
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Mapping
 
@@ -82,6 +86,26 @@ class Semantics:
     #: One rulebook for every arm: inputs and outputs do not depend on the number of joints
     #: (manifest ``dof = "any"``; the object is the same at every DOF and says ``dof = 2``).
     dof_free: bool = False
+    # --- The plug-in: what planners and training need to run this semantics ---------------
+    # ``fuzzy/`` imports no planner (layers import upward only), so code is named as
+    # ``"module:attribute"`` and imported on first use (:func:`resolve`; a semantics
+    # registered from above may give the function itself).
+    #: Training modes (``train --bounds``) this semantics offers -> the integer mode its
+    #: compiled kernel takes (the first is the mode of a rulebook without ``bounds_mode``);
+    #: empty: Fuzzy-RRT does not plan with it, nor does training make it.
+    modes: Mapping[str, int] = field(default_factory=lambda: MappingProxyType({}))
+    #: The Fuzzy-RRT kernel entry (plain-tuple arguments, the signature of
+    #: ``planners/fuzzy_rrt.py:fuzzy_rrt_entry``), or ``None``.
+    kernel: object = None
+    #: The fitness evaluation of a population in training: ``fn(problem, tree, knots_b,
+    #: consts_b, mode, seeds, max_iter) -> int64[P, R]`` iterations (``-1``: failed).
+    population: object = None
+    #: One fuzzy evaluation per arm (the paper's workspace inputs are one arm's: its DOF is
+    #: each arm's, and trace columns are prefixed ``arm<a>_``), else one for all arms (the
+    #: DOF is the joints in all).
+    per_arm: bool = False
+    #: The planner label that plans with it when nothing else is said.
+    planner: str = "fuzzy-rrt"
 
     @property
     def n_outputs(self) -> int:
@@ -91,6 +115,18 @@ class Semantics:
     def for_dof(self, dof: int) -> "Semantics":
         """This semantics at *dof* joints (the same cached object for the same DOF)."""
         return get(self.name, dof)
+
+    def kernel_mode(self, bounds_mode: str | None) -> int:
+        """The integer the compiled kernel takes for a rulebook with *bounds_mode* (chosen once
+        per plan): that mode's, else the first mode's (0 when there is none)."""
+        mode = self.modes.get(bounds_mode) if bounds_mode is not None else None
+        if mode is None:
+            mode = next(iter(self.modes.values()), 0)
+        return mode
+
+    def fis_groups(self, n_arms: int) -> int:
+        """Fuzzy evaluations per iteration on a problem of *n_arms* arms (trace groups)."""
+        return n_arms if self.per_arm else 1
 
     def default_knots(self, name: str) -> tuple[float, float, float, float, float]:
         """``(lo, p1, p2, p3, hi)`` for input *name* with the default peaks."""
@@ -115,6 +151,11 @@ PAPER = Semantics(
     default_peaks=_ro(_paper.DEFAULT_PEAKS),
     summary="the paper's: workspace angle/distance to goal and nearest obstacle -> goal bias, "
             "joint box (absolute or relative bounds), step",
+    # the integers of planners/fuzzy_rrt.py's BOUNDS_ABSOLUTE and BOUNDS_RELATIVE
+    modes=_ro({"absolute": 0, "relative": 1}),
+    kernel="xfuzzy_rrt.planners.fuzzy_rrt:fuzzy_rrt_entry",
+    population="xfuzzy_rrt.training.evaluate:memo_population",
+    per_arm=True,
 )
 
 GOAL_FRAME = Semantics(
@@ -142,6 +183,9 @@ GOAL_FRAME = Semantics(
     summary="goal-frame: joint-space distance to goal, stagnation, C-space clearance, reject "
             "rate -> goal bias, uniform share, box ahead/behind/across the direction to the "
             "goal, step",
+    modes=_ro({"goal-frame": 2}),  # planners/fuzzy_rrt.py's GOAL_FRAME
+    kernel="xfuzzy_rrt.planners.fuzzy_rrt:goal_frame_entry",
+    population="xfuzzy_rrt.training.evaluate:kernel_population",
 )
 
 #: Joint-space lengths of ``goal-frame-any`` are Euclidean degrees divided by ``sqrt(N / 2)``
@@ -174,15 +218,19 @@ GOAL_FRAME_ANY = Semantics(
             "length in normalised degrees (Euclidean degrees / sqrt(N/2), N joints in all), so "
             "one rulebook plans 2 to 7 joints and several arms",
     dof_free=True,
+    planner="fuzzy-rrt-connect",
 )
 
-SEMANTICS: Mapping[str, Semantics] = _ro({s.name: s for s in (PAPER, GOAL_FRAME, GOAL_FRAME_ANY)})
+#: The registry: name -> semantics at 2 DOF (a live read-only view; :func:`register` adds).
+_REGISTRY: dict[str, Semantics] = {s.name: s for s in (PAPER, GOAL_FRAME, GOAL_FRAME_ANY)}
+SEMANTICS: Mapping[str, Semantics] = MappingProxyType(_REGISTRY)
 DEFAULT = PAPER
 
 #: Every input name of every semantics and its range (input names are unique across semantics,
 #: so a FIS's inputs alone say which semantics it belongs to).
-ALL_INPUT_RANGES: Mapping[str, tuple[float, float]] = _ro(
-    {n: r for s in SEMANTICS.values() for n, r in s.input_ranges.items()})
+_ALL_INPUTS: dict[str, tuple[float, float]] = {
+    n: r for s in _REGISTRY.values() for n, r in s.input_ranges.items()}
+ALL_INPUT_RANGES: Mapping[str, tuple[float, float]] = MappingProxyType(_ALL_INPUTS)
 
 
 MIN_DOF = 2
@@ -226,23 +274,15 @@ def _paper_at(dof: int) -> Semantics:
               "step_size": PAPER.output_ranges["step_size"]}
     units = {**{n: PAPER.units[n] for n in PAPER.inputs}, "goal_bias": "",
              **{b: "deg" for b in bounds}, "step_size": "deg"}
-    return Semantics(
-        name=PAPER.name, inputs=PAPER.inputs, outputs=outputs, input_ranges=PAPER.input_ranges,
-        output_ranges=_ro(ranges), units=_ro(units), default_terms=PAPER.default_terms,
-        default_peaks=PAPER.default_peaks, summary=f"{PAPER.summary} ({dof} joints)", dof=dof,
-    )
+    return replace(PAPER, outputs=outputs, output_ranges=_ro(ranges), units=_ro(units),
+                   summary=f"{PAPER.summary} ({dof} joints)", dof=dof)
 
 
 def _goal_frame_at(dof: int) -> Semantics:
     ranges = dict(GOAL_FRAME.input_ranges)
     ranges["joint_dist_to_goal"] = joint_dist_range(dof)
-    return Semantics(
-        name=GOAL_FRAME.name, inputs=GOAL_FRAME.inputs, outputs=GOAL_FRAME.outputs,
-        input_ranges=_ro(ranges), output_ranges=GOAL_FRAME.output_ranges,
-        units=GOAL_FRAME.units, default_terms=GOAL_FRAME.default_terms,
-        default_peaks=GOAL_FRAME.default_peaks,
-        summary=f"{GOAL_FRAME.summary} ({dof} joints in all)", dof=dof,
-    )
+    return replace(GOAL_FRAME, input_ranges=_ro(ranges),
+                   summary=f"{GOAL_FRAME.summary} ({dof} joints in all)", dof=dof)
 
 
 _BUILDERS = {PAPER.name: _paper_at, GOAL_FRAME.name: _goal_frame_at,
@@ -251,6 +291,72 @@ _BUILDERS = {PAPER.name: _paper_at, GOAL_FRAME.name: _goal_frame_at,
 #: semantics is its constant at every DOF).
 _CACHE: dict[tuple[str, int], Semantics] = {(s.name, DEFAULT_DOF): s
                                             for s in (PAPER, GOAL_FRAME, GOAL_FRAME_ANY)}
+
+
+def register(sem: Semantics, at_dof=None) -> Semantics:
+    """Add a semantics (its 2-DOF object) to the registry: every tool that reads names,
+    ranges and units, the genome (:func:`of_mode`) and the planner kernel (:attr:`Semantics.kernel`)
+    then know it. ``at_dof(dof) -> Semantics``: the semantics at another DOF (``None``: the
+    same object at every DOF, as for a DOF-free semantics). ``ValueError`` when its name,
+    an input name or a training mode is taken."""
+    if sem.name in _REGISTRY:
+        raise ValueError(f"semantics {sem.name!r} is already registered")
+    taken = set(sem.inputs) & set(_ALL_INPUTS)
+    if taken:
+        raise ValueError(f"semantics {sem.name!r}: input names must be unique across "
+                         f"semantics; {', '.join(sorted(taken))} taken")
+    modes = set(sem.modes) & {m for s in _REGISTRY.values() for m in s.modes}
+    if modes:
+        raise ValueError(f"semantics {sem.name!r}: training mode(s) {', '.join(sorted(modes))} "
+                         "taken")
+    _REGISTRY[sem.name] = sem
+    _ALL_INPUTS.update(sem.input_ranges)
+    _BUILDERS[sem.name] = at_dof or (lambda dof: sem)
+    _CACHE[(sem.name, DEFAULT_DOF)] = sem
+    return sem
+
+
+def unregister(name: str) -> None:
+    """Remove a semantics :func:`register` added (tests)."""
+    sem = _REGISTRY.pop(name)
+    for n in sem.inputs:
+        _ALL_INPUTS.pop(n, None)
+    _BUILDERS.pop(name, None)
+    for key in [k for k in _CACHE if k[0] == name]:
+        del _CACHE[key]
+
+
+def of_mode(mode: str) -> Semantics:
+    """The (2-DOF) semantics that offers training mode *mode* (``absolute``, ``relative``,
+    ``goal-frame``, or a registered semantics' own); the paper's for an unknown mode, as
+    before the registry (callers validate modes against :func:`training_modes`)."""
+    for s in _REGISTRY.values():
+        if mode in s.modes:
+            return s
+    return PAPER
+
+
+def training_modes() -> tuple[str, ...]:
+    """Every training mode of every registered semantics, in registration order."""
+    return tuple(m for s in _REGISTRY.values() for m in s.modes)
+
+
+def resolve(ref):
+    """The object a ``"module:attribute"`` name of a plug-in field refers to, imported once
+    and kept; anything else (``None``, a function a registered semantics gives directly) as
+    given."""
+    if not isinstance(ref, str):
+        return ref
+    obj = _RESOLVED.get(ref)
+    if obj is None:
+        import importlib
+
+        module, _, attr = ref.partition(":")
+        obj = _RESOLVED[ref] = getattr(importlib.import_module(module), attr)
+    return obj
+
+
+_RESOLVED: dict[str, object] = {}
 
 
 def get(name: str | None, dof: int = DEFAULT_DOF) -> Semantics:

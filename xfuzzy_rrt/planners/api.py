@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import Scenario
+from xfuzzy_rrt.planners import registry as _registry
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
 
+#: The built-in exact planner names (every accepted label form is in planners/registry.py).
 PLANNERS = ("rrt", "fuzzy-rrt", "fuzzy-rrt-connect")
 TRACE_SUFFIXES = (".parquet", ".csv")
 #: ``ompl:NAME`` runs OMPL's geometric planner NAME (optional extra; see planners/ompl_bridge.py).
@@ -21,8 +23,6 @@ FUZZY_PREFIX = "fuzzy-rrt:"
 RRT_TUNED = "rrt:tuned"
 #: ``fuzzy-rrt-connect:NAME|DIR``: Fuzzy-RRT-Connect with that goal-frame(-any) rulebook.
 CONNECT_PREFIX = "fuzzy-rrt-connect:"
-#: Planner kinds that take a rulebook (and can record traces).
-RULEBOOK_KINDS = ("fuzzy-rrt", "fuzzy-rrt-connect")
 #: What plain ``fuzzy-rrt`` runs, with no rulebook named, on a problem that is not one 2-joint
 #: arm (see :func:`shipped_default`), with that planner's own default, the DOF-free
 #: ``goal-frame-any``.
@@ -38,22 +38,24 @@ class PlannerSpec:
 
     ``label`` is the text itself (``"fuzzy-rrt:paper"``): it names the planner in every table
     so that several rulebooks can stand side by side. ``kind`` is ``rrt``, ``fuzzy-rrt``,
-    ``fuzzy-rrt-connect`` or ``ompl``; ``rulebook_dir`` is the directory a ``fuzzy-rrt:...``
-    or ``fuzzy-rrt-connect:...`` label names (``None`` for the plain names: the caller's
-    rulebook or the planner's shipped default).
+    ``fuzzy-rrt-connect`` or ``ompl`` (or a registered planner's kind); ``rulebook_dir`` is
+    the directory a ``fuzzy-rrt:...`` or ``fuzzy-rrt-connect:...`` label names (``None`` for
+    the plain names: the caller's rulebook or the planner's shipped default). ``planner`` is
+    the registration of the label's form (:class:`~xfuzzy_rrt.planners.registry.Planner`):
+    what the planner can do (``takes_rulebook``, ``traces``, ...).
     """
 
     label: str
     kind: str
     rulebook_dir: Path | None = None
+    planner: _registry.Planner | None = field(default=None, compare=False, repr=False)
 
 
 def is_known_planner(name: str) -> bool:
-    """A built-in planner name, ``fuzzy-rrt:...`` or ``ompl:NAME`` (the part after the colon
-    is checked by :func:`parse_planner`). Cheap and import-free, for argument parsing."""
-    return name in PLANNERS or name == RRT_TUNED or any(
-        name.startswith(p) and len(name) > len(p)
-        for p in (OMPL_PREFIX, FUZZY_PREFIX, CONNECT_PREFIX))
+    """A registered planner label: ``rrt``, ``fuzzy-rrt:...``, ``ompl:NAME``, ... (the part
+    after the colon is checked by :func:`parse_planner`). Cheap and import-free, for argument
+    parsing."""
+    return _registry.lookup(name) is not None
 
 
 def default_rulebook_dir(kind: str) -> Path:
@@ -149,29 +151,28 @@ def rulebook_dir_of(arg: str, where: str, prefix: str = FUZZY_PREFIX) -> Path:
 def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
     """Validate a planner label fully, before any run: raises one InputError naming ``where``.
 
-    For ``ompl:NAME`` this imports OMPL, so a missing extra or an unknown OMPL planner fails
-    here with the same line it would give when planning. For ``fuzzy-rrt:NAME`` the rulebook
-    directory must exist (loading it, which validates every rule, is the caller's next step).
+    The label's form is looked up in the planner registry (:mod:`xfuzzy_rrt.planners.registry`),
+    whose ``parse`` hook checks the rest: for ``ompl:NAME`` this imports OMPL, so a missing
+    extra or an unknown OMPL planner fails here with the same line it would give when planning;
+    for ``fuzzy-rrt:NAME`` the rulebook directory must exist (loading it, which validates every
+    rule, is the caller's next step).
     """
-    if name in PLANNERS:
-        return PlannerSpec(name, name)
-    if name == RRT_TUNED:
-        _tuned_rrt(where)
-        return PlannerSpec(name, "rrt")
-    if name.startswith(FUZZY_PREFIX) and len(name) > len(FUZZY_PREFIX):
-        return PlannerSpec(name, "fuzzy-rrt", rulebook_dir_of(name[len(FUZZY_PREFIX):], where))
-    if name.startswith(CONNECT_PREFIX) and len(name) > len(CONNECT_PREFIX):
-        return PlannerSpec(name, "fuzzy-rrt-connect",
-                           rulebook_dir_of(name[len(CONNECT_PREFIX):], where, CONNECT_PREFIX))
-    if name.startswith(OMPL_PREFIX) and len(name) > len(OMPL_PREFIX):
-        from xfuzzy_rrt.planners.ompl_bridge import check_ompl_planner
+    entry = _registry.lookup(name)
+    if entry is None:
+        raise InputError(where, f"unknown planner {name!r} (expected one of "
+                         f"{_registry.expected_text()})")
+    if entry.parse is None:
+        spec = _PLAIN_SPECS.get(name)
+        if spec is None or spec.planner is not entry:
+            spec = _PLAIN_SPECS[name] = PlannerSpec(name, entry.kind, None, entry)
+        return spec
+    arg = name[len(entry.label):] if entry.is_prefix else None
+    return PlannerSpec(name, entry.kind, entry.parse_fn(name, arg, where), entry)
 
-        check_ompl_planner(name, where)
-        return PlannerSpec(name, "ompl")
-    raise InputError(where, f"unknown planner {name!r} (expected one of "
-                     f"{', '.join(PLANNERS)}, {RRT_TUNED}, {FUZZY_PREFIX}RULEBOOK, "
-                     f"{CONNECT_PREFIX}RULEBOOK or "
-                     f"{OMPL_PREFIX}NAME)")
+
+#: The spec of each exact label without a parse hook (immutable, so made once: plan_scenario
+#: parses its label on every call).
+_PLAIN_SPECS: dict = {}
 
 
 def check_planner(name: str, where: str = "--planners") -> str:
@@ -201,58 +202,93 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     certified clearance in metres (default: the scenario's ``clearance_m``, else 0).
     ``max_time_s``: a wall-clock budget on top of ``max_iter`` (whichever ends first;
     :mod:`xfuzzy_rrt.planners.termination`).
+    Every planner goes through its registration's ``plan`` (:mod:`.registry`): one dict
+    look-up, no chain of names.
     """
     from xfuzzy_rrt.planners.rng import check_seed
 
     check_seed(seed)
     spec = parse_planner(planner, "--planner")
-    if spec.kind not in RULEBOOK_KINDS and trace:
-        raise InputError("--trace", "traces record fuzzy decisions; use --planner fuzzy-rrt "
-                         "or fuzzy-rrt-connect")
-    if spec.kind == "rrt":
-        from xfuzzy_rrt.planners.rrt import plan_rrt
+    entry = spec.planner
+    if trace and not entry.traces:
+        raise InputError("--trace", "traces record fuzzy decisions; use --planner "
+                         f"{_registry.either(_registry.exact_labels(traces=True))}")
+    return entry.plan_fn(scenario, spec, rulebook, seed=seed, max_iter=max_iter,
+                         step_deg=step_deg, goal_bias=goal_bias, trace=trace,
+                         clearance_m=clearance_m, max_time_s=max_time_s)
 
-        if spec.label == RRT_TUNED:  # the label fixes the settings: the tuned file's
-            tuned = _tuned_rrt("--planner")
-            result = plan_rrt(scenario, seed=seed, max_iter=max_iter, clearance_m=clearance_m,
-                              max_time_s=max_time_s, **tuned)
-            return replace_result(result, planner=RRT_TUNED, planner_used=RRT_TUNED,
-                                  params={**result.params, "tuned": True})
-        return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
-                        goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
-    if spec.kind in RULEBOOK_KINDS:
-        kind = spec.kind
-        default = rulebook if isinstance(rulebook, ShippedDefault) else None
-        if default is not None:  # the shipped default, preloaded: the same as rulebook=None
-            rulebook = None
-        if spec.rulebook_dir is not None:
-            if rulebook is not None and not _same_rulebook(rulebook, spec.rulebook_dir):
-                raise InputError("--rulebook", f"conflicts with --planner {spec.label} (which "
-                                 "names its own rulebook); give only one")
-            rulebook = rulebook if rulebook is not None else spec.rulebook_dir
-        elif rulebook is None and kind == "fuzzy-rrt":
-            # No rulebook named: the shipped default, per problem (shipped_default's rule).
-            if default is not None:
-                kind, rulebook = default.for_scenario(scenario)
-            else:
-                # rulebook None: that planner's own default (the rule without its ~0.1 ms
-                # rulebook-directory look-up, which the planner does anyway)
-                kind = "fuzzy-rrt" if is_two_joint_problem(scenario) else ANY_ARM_PLANNER
-        elif rulebook is None and default is not None:
-            rulebook = default.any_arm
-        if kind == "fuzzy-rrt-connect":
-            from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect as plan_fuzzy
+
+# --- The built-in planners' hooks (registered in planners/registry.py) -------------------------
+
+def parse_tuned(label: str, arg, where: str) -> None:
+    """``rrt:tuned`` needs the shipped tuned file."""
+    _tuned_rrt(where)
+
+
+def parse_rulebook_arg(label: str, arg: str, where: str) -> Path:
+    """``fuzzy-rrt:ARG`` / ``fuzzy-rrt-connect:ARG``: the rulebook directory ARG names."""
+    return rulebook_dir_of(arg, where, label[:-len(arg)])
+
+
+def parse_ompl_arg(label: str, arg: str, where: str) -> None:
+    from xfuzzy_rrt.planners.ompl_bridge import check_ompl_planner
+
+    check_ompl_planner(label, where)
+
+
+def plan_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter, step_deg,
+                   goal_bias, trace, clearance_m, max_time_s) -> PlanResult:
+    """``rrt`` with ``step_deg``/``goal_bias``; ``rrt:tuned`` with the tuned file's."""
+    from xfuzzy_rrt.planners.rrt import plan_rrt
+
+    if spec.label == RRT_TUNED:  # the label fixes the settings: the tuned file's
+        tuned = _tuned_rrt("--planner")
+        result = plan_rrt(scenario, seed=seed, max_iter=max_iter, clearance_m=clearance_m,
+                          max_time_s=max_time_s, **tuned)
+        return replace_result(result, planner=RRT_TUNED, planner_used=RRT_TUNED,
+                              params={**result.params, "tuned": True})
+    return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
+                    goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
+
+
+def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter,
+                        step_deg, goal_bias, trace, clearance_m, max_time_s) -> PlanResult:
+    """``fuzzy-rrt[:RULEBOOK]`` and ``fuzzy-rrt-connect[:RULEBOOK]``: the rulebook the label or
+    the caller names, else the shipped default (:func:`shipped_default`'s rule for plain
+    ``fuzzy-rrt``); the kind that runs calls its registration's ``core``."""
+    kind = spec.kind
+    default = rulebook if isinstance(rulebook, ShippedDefault) else None
+    if default is not None:  # the shipped default, preloaded: the same as rulebook=None
+        rulebook = None
+    if spec.rulebook_dir is not None:
+        if rulebook is not None and not _same_rulebook(rulebook, spec.rulebook_dir):
+            raise InputError("--rulebook", f"conflicts with --planner {spec.label} (which "
+                             "names its own rulebook); give only one")
+        rulebook = rulebook if rulebook is not None else spec.rulebook_dir
+    elif rulebook is None and kind == "fuzzy-rrt":
+        # No rulebook named: the shipped default, per problem (shipped_default's rule).
+        if default is not None:
+            kind, rulebook = default.for_scenario(scenario)
         else:
-            from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt as plan_fuzzy
-        result = plan_fuzzy(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter,
-                            trace=trace, clearance_m=clearance_m, max_time_s=max_time_s)
-        if result.planner == spec.label and result.planner_used == kind:  # nothing to relabel
-            return result
-        return replace_result(result, planner=spec.label, planner_used=kind)
+            # rulebook None: that planner's own default (the rule without its ~0.1 ms
+            # rulebook-directory look-up, which the planner does anyway)
+            kind = "fuzzy-rrt" if is_two_joint_problem(scenario) else ANY_ARM_PLANNER
+    elif rulebook is None and default is not None:
+        rulebook = default.any_arm
+    core = (spec.planner if kind == spec.kind else _registry.lookup(kind)).core_fn
+    result = core(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter, trace=trace,
+                  clearance_m=clearance_m, max_time_s=max_time_s)
+    if result.planner == spec.label and result.planner_used == kind:  # nothing to relabel
+        return result
+    return replace_result(result, planner=spec.label, planner_used=kind)
+
+
+def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter, step_deg,
+                    goal_bias, trace, clearance_m, max_time_s) -> PlanResult:
     from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
 
     # OMPL's range comes from the label (ompl:NAME:range=DEG) or the tuned file, not step_deg.
-    return plan_ompl(scenario, planner, seed=seed, max_iter=max_iter, goal_bias=goal_bias,
+    return plan_ompl(scenario, spec.label, seed=seed, max_iter=max_iter, goal_bias=goal_bias,
                      clearance_m=clearance_m, time_limit_s=max_time_s)
 
 

@@ -84,10 +84,9 @@ GOAL_FRAME = 2
 
 
 def kernel_mode(rb) -> int:
-    """The integer mode the compiled kernels take for rulebook *rb* (chosen once per plan)."""
-    if rb.semantics.name == "goal-frame":
-        return GOAL_FRAME
-    return BOUNDS_RELATIVE if rb.bounds_mode == "relative" else BOUNDS_ABSOLUTE
+    """The integer mode the compiled kernels take for rulebook *rb* (chosen once per plan):
+    its semantics' (:meth:`~xfuzzy_rrt.fuzzy.semantics.Semantics.kernel_mode`)."""
+    return rb.semantics.kernel_mode(rb.bounds_mode)
 
 
 def kernel_for(mode: int):
@@ -96,8 +95,9 @@ def kernel_for(mode: int):
 
 
 def fis_groups(rb, scenario: Scenario) -> int:
-    """Fuzzy evaluations per iteration: one per arm (paper), one for all arms (goal-frame)."""
-    return 1 if kernel_mode(rb) == GOAL_FRAME else len(scenario.arms)
+    """Fuzzy evaluations per iteration: one per arm (paper), one for all arms (goal-frame);
+    the semantics says (:attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.per_arm`)."""
+    return rb.semantics.fis_groups(len(scenario.arms))
 
 
 def check_rulebook_fits(rb, scenario: Scenario) -> None:
@@ -118,11 +118,12 @@ def check_rulebook_fits(rb, scenario: Scenario) -> None:
         raise InputError(where, f"rulebook {rb.name!r} has the {rb.semantics.name} semantics, "
                          "which plans with --planner fuzzy-rrt-connect (fuzzy-rrt takes paper "
                          "and goal-frame rulebooks)")
-    if kernel_mode(rb) == GOAL_FRAME:
+    if not rb.semantics.per_arm:  # reads the joints of all arms together
         if dof != scenario.dof:
-            raise InputError(where, f"rulebook {rb.name!r} is a {dof}-DOF goal-frame rulebook; "
-                             f"this problem has {scenario.dof} joints in all (train or pick a "
-                             f"{scenario.dof}-DOF rulebook{default})")
+            raise InputError(where, f"rulebook {rb.name!r} is a {dof}-DOF "
+                             f"{rb.semantics.name} rulebook; this problem has {scenario.dof} "
+                             f"joints in all (train or pick a {scenario.dof}-DOF "
+                             f"rulebook{default})")
         return
     for a, arm in enumerate(scenario.arms):
         if arm.dof != dof:
@@ -275,8 +276,23 @@ def goal_frame_entry(p, t, seed, max_iter, knots, consts, mode, min_step, stop, 
 
 
 def entry_for(mode: int):
-    """:func:`kernel_for`'s loop, called with plain tuples (what :func:`plan_fuzzy_rrt` uses)."""
-    return goal_frame_entry if mode == GOAL_FRAME else fuzzy_rrt_entry
+    """The compiled loop of the semantics whose kernel takes *mode*, called with plain tuples
+    (what :func:`plan_fuzzy_rrt` uses): :attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.kernel`,
+    looked up in one dict (a mode belongs to one semantics)."""
+    entry = _ENTRIES.get(mode)
+    if entry is None:
+        from xfuzzy_rrt.fuzzy.semantics import SEMANTICS, resolve
+
+        owner = next((s for s in SEMANTICS.values() if mode in s.modes.values() and s.kernel),
+                     None)
+        if owner is None:
+            raise ValueError(f"no semantics has a Fuzzy-RRT kernel for mode {mode!r}")
+        entry = _ENTRIES[mode] = resolve(owner.kernel)
+    return entry
+
+
+#: mode -> kernel entry, filled from the semantics registry on first use.
+_ENTRIES: dict[int, object] = {}
 
 
 def _resolve_rulebook(rulebook):

@@ -55,12 +55,21 @@ def default(planner: str, name: str):
 
 
 def describe(planner: str) -> list[Param]:
-    """The parameters of ``planner`` (``rrt`` or ``fuzzy-rrt``)."""
-    try:
-        return list(PARAMS[planner])
-    except KeyError:
+    """The parameters of ``planner``: ``rrt`` or ``fuzzy-rrt``, or any registered planner label
+    whose registration declares them (:attr:`xfuzzy_rrt.planners.registry.Planner.params`: a
+    key of :data:`PARAMS` or the declaration itself)."""
+    declared = PARAMS.get(planner)
+    if declared is None:
+        from xfuzzy_rrt.planners.registry import lookup
+
+        form = lookup(planner)
+        declared = getattr(form, "params", None)
+        if isinstance(declared, str):
+            declared = PARAMS.get(declared)
+    if declared is None:
         raise InputError("planner", f"no parameters are declared for {planner!r} "
-                         f"(known: {', '.join(PARAMS)})") from None
+                         f"(known: {', '.join(PARAMS)})")
+    return list(declared)
 
 
 def resolve_params(planner: str, **given) -> dict:

@@ -87,7 +87,7 @@ def _shipped_with_sha(name: str, sha: str):
 
 def _replay_result(path: Path, rulebook: Path | None):
     from xfuzzy_rrt.geometry.scenario import load_scenario
-    from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
+    from xfuzzy_rrt.planners import registry
 
     if not path.exists():
         raise InputError(str(path), "no such file")
@@ -98,8 +98,9 @@ def _replay_result(path: Path, rulebook: Path | None):
     # planner_used: what ran (plain fuzzy-rrt plans a problem that is not one 2-joint arm with
     # fuzzy-rrt-connect and goal-frame-any; planners/api.py:shipped_default)
     used = (data.get("planner_used") or data.get("planner")) if isinstance(data, dict) else None
-    if used not in ("fuzzy-rrt", "fuzzy-rrt-connect"):
-        raise InputError(str(path), "planner: only fuzzy-rrt and fuzzy-rrt-connect results can "
+    tracing = registry.exact_labels(traces=True)  # the planners that record traces
+    if used not in tracing:
+        raise InputError(str(path), f"planner: only {registry.either(tracing, 'and')} results can "
                          "be explained")
     for key in ("scenario_file", "rulebook_dir", "rulebook_sha256", "seed"):
         if key not in data:
@@ -124,10 +125,11 @@ def _replay_result(path: Path, rulebook: Path | None):
                              f"{sha[:12]}… recorded); pass the rulebook that made it with "
                              "--rulebook DIR")
     max_iter = int(data.get("params", {}).get("max_iter", 10_000))
-    plan = plan_fuzzy_rrt
-    if used == "fuzzy-rrt-connect":
-        from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect as plan
-    result = plan(scenario, rb, seed=int(data["seed"]), max_iter=max_iter, trace=True)
+    from xfuzzy_rrt.planners.api import plan_scenario
+
+    # what ran (planner_used), with this rulebook, through the planner registry
+    result = plan_scenario(scenario, used, rulebook=rb, seed=int(data["seed"]),
+                           max_iter=max_iter, trace=True)
     if result.iterations != data.get("iterations"):
         raise InputError(str(path), "iterations: the replay does not reproduce this result")
     return result.trace, rb

@@ -80,11 +80,20 @@ def _scenario_details(s) -> str:
 def cli_planner(label: str) -> str:
     """The ``plan --planner`` value that reruns a benchmark label whose rulebook is passed as
     ``--rulebook``: ``fuzzy-rrt:NAME`` -> ``fuzzy-rrt``, ``fuzzy-rrt-connect:NAME`` ->
-    ``fuzzy-rrt-connect`` (Fuzzy-RRT refuses a Connect rulebook), anything else itself."""
-    for kind in ("fuzzy-rrt-connect", "fuzzy-rrt"):
-        if label == kind or label.startswith(kind + ":"):
-            return kind
-    return label
+    ``fuzzy-rrt-connect`` (Fuzzy-RRT refuses a Connect rulebook), anything else itself
+    (:meth:`xfuzzy_rrt.planners.registry.Planner.cli_name`)."""
+    from xfuzzy_rrt.planners.registry import lookup
+
+    entry = lookup(label)
+    return label if entry is None else entry.cli_name(label)
+
+
+def takes_rulebook(label: str) -> bool:
+    """A planner label whose planner plans with a rulebook (the registry says)."""
+    from xfuzzy_rrt.planners.registry import lookup
+
+    entry = lookup(label)
+    return entry is not None and entry.takes_rulebook
 
 
 def _plan_cmd(s, planner: str, seed: int, settings: dict) -> str:
@@ -94,7 +103,7 @@ def _plan_cmd(s, planner: str, seed: int, settings: dict) -> str:
            f"--seed {int(seed)}")
     if settings.get("max_iter") is not None:
         cmd += f" --max-iter {int(settings['max_iter'])}"
-    if planner in ("fuzzy-rrt", "fuzzy-rrt-connect") and settings.get("rulebook_dir"):
+    if takes_rulebook(planner) and settings.get("rulebook_dir"):
         cmd += f" --rulebook {shlex.quote(str(settings['rulebook_dir']))}"
     return cmd
 

@@ -89,8 +89,11 @@ def rulebook_dir(planner: str, result) -> str | None:
             return str(entry["dir"])
     if planner == "fuzzy-rrt":
         return settings.get("rulebook_dir")
-    if planner.startswith(("fuzzy-rrt:", "fuzzy-rrt-connect:")):
-        return planner.split(":", 1)[1]
+    from xfuzzy_rrt.planners.registry import lookup
+
+    form = lookup(planner)  # fuzzy-rrt:NAME, fuzzy-rrt-connect:DIR, ...: the part after ':'
+    if form is not None and form.is_prefix and form.takes_rulebook:
+        return planner[len(form.label):]
     return None
 
 
@@ -492,7 +495,7 @@ def _exists_beside(ctx, name: str) -> bool:
 
 def _plan_cmd(ctx, s, planner: str, seed: int, run=None) -> str:
     src = getattr(s, "source", "") or f"{s.name}.toml"
-    from xfuzzy_rrt.report.evidence import cli_planner
+    from xfuzzy_rrt.report.evidence import cli_planner, takes_rulebook
 
     plan_planner = cli_planner(planner)
     cmd = (f"xfuzzy-rrt plan {shlex.quote(src)} --planner {shlex.quote(plan_planner)} "
@@ -500,7 +503,7 @@ def _plan_cmd(ctx, s, planner: str, seed: int, run=None) -> str:
     if ctx["settings"].get("max_iter") is not None:
         cmd += f" --max-iter {int(ctx['settings']['max_iter'])}"
     d = (rulebook_dir(planner, ctx["result"])
-         if plan_planner in ("fuzzy-rrt", "fuzzy-rrt-connect") else None)
+         if takes_rulebook(plan_planner) else None)
     if d and not _ran_any_arm_default(planner, run):
         cmd += f" --rulebook {shlex.quote(str(d))}"
     return cmd

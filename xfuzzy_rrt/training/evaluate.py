@@ -25,13 +25,8 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.planners.fuzzy_rrt import (
-    BOUNDS_ABSOLUTE,
-    BOUNDS_RELATIVE,
-    GOAL_FRAME,
-    MIN_STEP_DEG,
-    fuzzy_rrt_kernel,
-)
+from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.planners.fuzzy_rrt import GOAL_FRAME, MIN_STEP_DEG, fuzzy_rrt_kernel
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.trace_record import make_trace
 from xfuzzy_rrt.planners.tree import make_tree, reset_tree
@@ -47,6 +42,9 @@ def run_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_st
     ``knots_b`` [P, n_out, 4, 5] and ``consts_b`` [P, n_out, 625] are decoded individuals;
     ``T`` is one preallocated tree (:func:`~xfuzzy_rrt.planners.tree.make_tree`), emptied
     before each run; ``TR`` 1-row trace buffers the kernels never touch (``record`` is off).
+    ``bounds_mode`` is the integer the semantics' kernel takes (``Semantics.kernel_mode``;
+    compiled code cannot take the semantics object, so the choice of loop stays this one
+    integer test per run).
     """
     n_ind = knots_b.shape[0]
     n_seeds = seeds.shape[0]
@@ -104,24 +102,38 @@ def iterations_for(problems: list[TrainingProblem], knots_b: np.ndarray, consts_
     arguments, so splitting a population into chunks never changes any number. The paper's
     semantics runs through :func:`~.memo.paper_population` (the planner's loop with its pure
     per-node work remembered: the same numbers, about 30 % less CPU), the goal-frame one
-    through :func:`run_population` (the planner's own kernel).
+    through :func:`run_population` (the planner's own kernel): the semantics that offers
+    *bounds_mode* names its evaluation and its kernel mode
+    (:attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.population`, ``modes``).
     """
-    mode = {"relative": BOUNDS_RELATIVE, "goal-frame": GOAL_FRAME}.get(bounds_mode, BOUNDS_ABSOLUTE)
+    sem = _sem.of_mode(bounds_mode)
+    mode = sem.kernel_mode(bounds_mode)
+    population = _sem.resolve(sem.population)
     knots_b = np.ascontiguousarray(knots_b, dtype=np.float64)
     consts_b = np.ascontiguousarray(consts_b, dtype=np.float64)
     seeds = np.ascontiguousarray(seeds, dtype=np.int64)
     out = np.empty((knots_b.shape[0], len(problems), seeds.shape[0]), dtype=np.int64)
-    stop = np.zeros(1, dtype=np.int64)
     for s, pr in enumerate(problems):
         tree = make_tree(int(max_iter) + 2, pr.limits)
-        if mode == GOAL_FRAME:
-            buffers = make_trace(1, pr.dof, knots_b.shape[1], 1)
-            out[:, s, :] = run_population(pr.bundle, tree, knots_b, consts_b, mode, seeds,
-                                          int(max_iter), MIN_STEP_DEG, stop, buffers)
-        else:
-            out[:, s, :] = paper_population(pr.bundle, tree, knots_b, consts_b, mode, seeds,
-                                            int(max_iter), MIN_STEP_DEG)
+        out[:, s, :] = population(pr, tree, knots_b, consts_b, mode, seeds, int(max_iter))
     return out
+
+
+def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, seeds,
+                      max_iter: int) -> np.ndarray:
+    """A population's iterations through the planner's own kernel (:func:`run_population`):
+    the ``population`` of a semantics with no faster evaluation (goal-frame)."""
+    buffers = make_trace(1, pr.dof, knots_b.shape[1], 1)
+    return run_population(pr.bundle, tree, knots_b, consts_b, mode, seeds, int(max_iter),
+                          MIN_STEP_DEG, np.zeros(1, dtype=np.int64), buffers)
+
+
+def memo_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, seeds,
+                    max_iter: int) -> np.ndarray:
+    """A population's iterations through :func:`~.memo.paper_population` (the paper's
+    semantics: the planner's loop with its pure per-node work remembered)."""
+    return paper_population(pr.bundle, tree, knots_b, consts_b, mode, seeds, int(max_iter),
+                            MIN_STEP_DEG)
 
 
 def rewards(iterations: np.ndarray, max_iter: int) -> np.ndarray:

@@ -40,13 +40,16 @@ A_MIN = 0.05
 A_MAX = 0.95
 
 #: The planner modes a genome can be trained for: the paper's semantics with absolute or
-#: relative bounds, or the goal-frame semantics (which has no bounds mode).
-MODES = ("absolute", "relative", "goal-frame")
+#: relative bounds, or the goal-frame semantics (which has no bounds mode) -- each
+#: semantics' ``modes`` (:func:`xfuzzy_rrt.fuzzy.semantics.training_modes`).
+MODES = _sem.training_modes()
 
 
 def semantics_of_mode(mode: str, dof: int = DEFAULT_DOF) -> "_sem.Semantics":
-    """The rulebook semantics a training mode produces, at *dof* joints."""
-    return (_sem.GOAL_FRAME if mode == "goal-frame" else _sem.PAPER).for_dof(dof)
+    """The rulebook semantics a training mode produces, at *dof* joints: the registered
+    semantics that offers *mode* (:func:`xfuzzy_rrt.fuzzy.semantics.of_mode`), whose names
+    and ranges are the genome's layout."""
+    return _sem.of_mode(mode).for_dof(dof)
 
 
 def n_outputs(mode: str, dof: int = DEFAULT_DOF) -> int:

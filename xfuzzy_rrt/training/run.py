@@ -27,6 +27,8 @@ from typing import Callable
 
 
 from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.fuzzy.manifest import BOUNDS_MODES
+from xfuzzy_rrt.fuzzy.semantics import of_mode
 from xfuzzy_rrt.training.ga import HISTORY_COLUMNS, GAConfig, Trainer, TrainResult, new_state
 
 CHECKPOINT_DIR = "checkpoint"
@@ -73,7 +75,7 @@ def scenario_dof(scenario, bounds: str) -> int:
     the joint space of all arms together, so its DOF is the total (``scenario.dof``).
     """
     where = scenario.source or scenario.name
-    if bounds == "goal-frame":
+    if not of_mode(bounds).per_arm:  # the semantics reads the joints of all arms together
         return int(scenario.dof)
     dofs = [int(a.dof) for a in scenario.arms]
     if len(set(dofs)) != 1:
@@ -101,7 +103,7 @@ def training_dof(scenarios, bounds: str, dof: int | None = None) -> int:
         s = getattr(t, "scenario", t)
         d = scenario_dof(s, bounds)
         found.setdefault(d, str(getattr(t, "path", None) or s.source or s.name))
-    what = "joints in all" if bounds == "goal-frame" else "joints per arm"
+    what = "joints per arm" if _sem.of_mode(bounds).per_arm else "joints in all"
     if len(found) > 1:
         listed = "; ".join(f"{f} has {d}" for d, f in sorted(found.items()))
         raise InputError("--scenario", f"training scenarios of different DOF ({what}): {listed}; "
@@ -186,11 +188,12 @@ def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str,
         if rb.dof != dof:
             raise InputError(str(p), f"seed rulebook is for dof {rb.dof}, the training for dof "
                              f"{dof}")
-        if bounds == "goal-frame":
-            if rb.semantics.name != "goal-frame":
-                raise InputError(str(p), "seed rulebook is not a goal-frame rulebook, but "
-                                 "--bounds is goal-frame")
-        elif rb.semantics.name != "paper" or rb.bounds_mode != bounds:
+        want = of_mode(bounds)  # the semantics --bounds trains
+        if bounds not in BOUNDS_MODES:  # a semantics without the paper's bounds modes
+            if rb.semantics.name != want.name:
+                raise InputError(str(p), f"seed rulebook is not a {want.name} rulebook, but "
+                                 f"--bounds is {bounds}")
+        elif rb.semantics.name != want.name or rb.bounds_mode != bounds:
             raise InputError(str(p), f"seed rulebook has {rb.bounds_mode} bounds, but "
                              f"--bounds is {bounds}")
         out.append(SeedRulebook(str(p), rb))
@@ -433,11 +436,11 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
             {"name": t.scenario.name, "file": t.path, "sha256": t.sha256} for t in job.validation]
         if c.fitness == "log-ratio":
             provenance["validation_baseline_iterations"] = [float(b) for b in c.validation_baseline]
-    what = "goal-frame semantics" if sem.name == "goal-frame" else f"{c.bounds} bounds"
+    bounds_mode = c.bounds if c.bounds in BOUNDS_MODES else None  # only the paper's has one
+    what = f"{c.bounds} bounds" if bounds_mode else f"{sem.name} semantics"
     description = (f"Trained by the genetic algorithm ({what}, {c.fitness} fitness) on "
                    f"{len(job.scenarios)} scenario(s); see [provenance].")
-    rb = Rulebook.from_arrays(knots[0], consts[0], name=name,
-                              bounds_mode=None if sem.name == "goal-frame" else c.bounds,
+    rb = Rulebook.from_arrays(knots[0], consts[0], name=name, bounds_mode=bounds_mode,
                               provenance=provenance, description=description, semantics=sem)
     return save_rulebook(rb, job.out)
 

@@ -12,7 +12,7 @@ import json
 from pathlib import Path
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
+from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 
 
 def trace_for(source: Path, rulebook: Path | None = None):

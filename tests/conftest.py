@@ -75,20 +75,34 @@ def thin_box(tmp_path: Path, ylo: float = -0.002, yhi: float = 0.002) -> Path:
 #
 # Why: with ``-n auto`` every worker would compile the same numba kernels side by side on a
 # cold cache (minutes each, and two writers of one cache entry). The controller compiles the
-# core planning kernels once, before any worker starts; the workers then load numba's on-disk
-# cache. Tests write only under ``tmp_path`` (per test, so per worker), never to fixed paths.
+# kernels most tests need once, before any worker starts; the workers then load numba's on-disk
+# cache. Compiling is single-threaded and takes minutes per planner (about 13 CPU-minutes for
+# everything below), so it runs as a few processes at once, each compiling its own planners
+# (a shared callee may be compiled twice; numba's cache writes are atomic). Tests write only
+# under ``tmp_path`` (per test, so per worker), never to fixed paths.
 
 
-def _warm_numba_cache() -> None:
-    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+def _warm_scenario():
     from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    return load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml")
+
+
+def _warm_rrt_and_fuzzy_rrt() -> None:
+    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
     from xfuzzy_rrt.planners.api import plan_scenario
 
-    s = load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml")
+    s = _warm_scenario()
     plan_scenario(s, planner="rrt", seed=0, max_iter=20)
     for name in ("goal-frame", "expert"):
         plan_scenario(s, planner="fuzzy-rrt", rulebook=rulebooks_dir() / name, seed=0,
                       max_iter=20, trace=True)
+
+
+def _warm_connect_and_certificate() -> None:
+    from xfuzzy_rrt.planners.api import plan_scenario
+
+    s = _warm_scenario()
     plan_scenario(s, planner="fuzzy-rrt-connect", seed=0, max_iter=20, trace=True)
     # The certificate and the exact minimum clearance (measured lazily, so no plan above
     # compiled them): tests with a time limit must not pay for their first compile.
@@ -97,6 +111,49 @@ def _warm_numba_cache() -> None:
     a = s.arrays()
     certify_path(a, [s.start_deg, s.goal_deg])
     path_min_clearance(a, [s.start_deg, s.goal_deg])
+
+
+def _warm_training(mode: str) -> None:
+    """The GA's population kernel of one semantics (``iterations_for``)."""
+    import numpy as np
+
+    from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for
+    from xfuzzy_rrt.training.genome import decode, n_genes
+
+    knots, consts = decode(np.full((1, n_genes(mode)), 0.5), mode)
+    iterations_for([TrainingProblem.from_scenario(_warm_scenario())], knots, consts, mode,
+                   np.array([0]), 20)
+
+
+def _warm_goal_frame_training_generator_and_engine() -> None:
+    import numpy as np
+
+    from xfuzzy_rrt.fuzzy.engine import evaluate
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
+    from xfuzzy_rrt.scenarios.generate import generate_one
+
+    _warm_training("goal-frame")
+    generate_one(0, 0)
+    evaluate(*load_rulebook(rulebooks_dir() / "expert").arrays(), np.zeros((1, 4)))
+
+
+#: Each run in its own process by :func:`_warm_numba_cache`, all at once.
+_WARM_GROUPS = {
+    "rrt-and-fuzzy-rrt": _warm_rrt_and_fuzzy_rrt,
+    "connect-and-certificate": _warm_connect_and_certificate,
+    "paper-training": lambda: _warm_training("relative"),
+    "goal-frame-training": _warm_goal_frame_training_generator_and_engine,
+}
+
+
+def _warm_numba_cache() -> None:
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); import conftest; "
+            "conftest._WARM_GROUPS[sys.argv[2]]()")
+    procs = {name: subprocess.Popen([sys.executable, "-c", code, str(TESTS), name], cwd=PROJECT)
+             for name in _WARM_GROUPS}
+    failed = [name for name, proc in procs.items() if proc.wait() != 0]
+    if failed:
+        raise RuntimeError(f"warming the numba cache failed ({', '.join(failed)}); see above")
 
 
 def pytest_configure(config):

@@ -39,6 +39,48 @@ def run_cli():
     return _run
 
 
+def run_main(*args, cwd: str | os.PathLike[str] | None = None,
+             timeout: float | None = None) -> subprocess.CompletedProcess:
+    """``xfuzzy-rrt ARGS...`` through the console script's own function, ``main(argv)``, in
+    this process: the exit code, stdout and stderr the script gives (text as ``run_cli``
+    decodes it; an uncaught exception is a traceback on stderr and exit code 1, as Python
+    does), without paying for a new interpreter and its numpy/numba/pandas imports (about 1.5 s
+    a call). For tests of what a command computes, prints and writes; ``run_cli`` stays for
+    what needs a real process (signals, time limits, the installed entry point, start-up)."""
+    import contextlib
+    import io
+    import traceback
+
+    from xfuzzy_rrt.cli.main import main
+
+    del timeout  # in-process: pytest's own time limit, if any, applies
+    raw_out, raw_err = io.BytesIO(), io.BytesIO()
+    out = io.TextIOWrapper(raw_out, encoding="utf-8", write_through=True)
+    err = io.TextIOWrapper(raw_err, encoding="utf-8", write_through=True)
+    here = os.getcwd()
+    try:
+        if cwd is not None:
+            os.chdir(cwd)
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = main([str(a) for a in args])
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+            except Exception:
+                traceback.print_exc()
+                code = 1
+            out.flush()
+            err.flush()
+    finally:
+        os.chdir(here)
+
+    def text(raw: io.BytesIO) -> str:  # universal newlines, as subprocess.run(text=True)
+        return raw.getvalue().decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")
+
+    return subprocess.CompletedProcess(["xfuzzy-rrt", *map(str, args)], code, text(raw_out),
+                                       text(raw_err))
+
+
 def shared_scenarios() -> list[Path]:
     """The shared scenario files when ``../shared/scenarios`` is present, else empty."""
     if not SHARED_SCENARIOS.is_dir():

@@ -44,7 +44,7 @@ def run_main(*args, cwd: str | os.PathLike[str] | None = None,
     """``xfuzzy-rrt ARGS...`` through the console script's own function, ``main(argv)``, in
     this process: the exit code, stdout and stderr the script gives (text as ``run_cli``
     decodes it; an uncaught exception is a traceback on stderr and exit code 1, as Python
-    does), without paying for a new interpreter and its numpy/numba/pandas imports (about 1.5 s
+    does; ``sys.argv`` as the script has it, for the command lines recorded), without paying for a new interpreter and its numpy/numba/pandas imports (about 1.5 s
     a call). For tests of what a command computes, prints and writes; ``run_cli`` stays for
     what needs a real process (signals, time limits, the installed entry point, start-up)."""
     import contextlib
@@ -57,8 +57,9 @@ def run_main(*args, cwd: str | os.PathLike[str] | None = None,
     raw_out, raw_err = io.BytesIO(), io.BytesIO()
     out = io.TextIOWrapper(raw_out, encoding="utf-8", write_through=True)
     err = io.TextIOWrapper(raw_err, encoding="utf-8", write_through=True)
-    here = os.getcwd()
+    here, argv = os.getcwd(), sys.argv
     try:
+        sys.argv = [console_script(), *map(str, args)]  # what the script sees (provenance)
         if cwd is not None:
             os.chdir(cwd)
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
@@ -73,6 +74,7 @@ def run_main(*args, cwd: str | os.PathLike[str] | None = None,
             err.flush()
     finally:
         os.chdir(here)
+        sys.argv = argv
 
     def text(raw: io.BytesIO) -> str:  # universal newlines, as subprocess.run(text=True)
         return raw.getvalue().decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")

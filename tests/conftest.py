@@ -39,6 +39,50 @@ def run_cli():
     return _run
 
 
+def run_main(*args, cwd: str | os.PathLike[str] | None = None,
+             timeout: float | None = None) -> subprocess.CompletedProcess:
+    """``xfuzzy-rrt ARGS...`` through the console script's own function, ``main(argv)``, in
+    this process: the exit code, stdout and stderr the script gives (text as ``run_cli``
+    decodes it; an uncaught exception is a traceback on stderr and exit code 1, as Python
+    does; ``sys.argv`` as the script has it, for the command lines recorded), without paying for a new interpreter and its numpy/numba/pandas imports (about 1.5 s
+    a call). For tests of what a command computes, prints and writes; ``run_cli`` stays for
+    what needs a real process (signals, time limits, the installed entry point, start-up)."""
+    import contextlib
+    import io
+    import traceback
+
+    from xfuzzy_rrt.cli.main import main
+
+    del timeout  # in-process: pytest's own time limit, if any, applies
+    raw_out, raw_err = io.BytesIO(), io.BytesIO()
+    out = io.TextIOWrapper(raw_out, encoding="utf-8", write_through=True)
+    err = io.TextIOWrapper(raw_err, encoding="utf-8", write_through=True)
+    here, argv = os.getcwd(), sys.argv
+    try:
+        sys.argv = [console_script(), *map(str, args)]  # what the script sees (provenance)
+        if cwd is not None:
+            os.chdir(cwd)
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = main([str(a) for a in args])
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+            except Exception:
+                traceback.print_exc()
+                code = 1
+            out.flush()
+            err.flush()
+    finally:
+        os.chdir(here)
+        sys.argv = argv
+
+    def text(raw: io.BytesIO) -> str:  # universal newlines, as subprocess.run(text=True)
+        return raw.getvalue().decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")
+
+    return subprocess.CompletedProcess(["xfuzzy-rrt", *map(str, args)], code, text(raw_out),
+                                       text(raw_err))
+
+
 def shared_scenarios() -> list[Path]:
     """The shared scenario files when ``../shared/scenarios`` is present, else empty."""
     if not SHARED_SCENARIOS.is_dir():
@@ -75,20 +119,34 @@ def thin_box(tmp_path: Path, ylo: float = -0.002, yhi: float = 0.002) -> Path:
 #
 # Why: with ``-n auto`` every worker would compile the same numba kernels side by side on a
 # cold cache (minutes each, and two writers of one cache entry). The controller compiles the
-# core planning kernels once, before any worker starts; the workers then load numba's on-disk
-# cache. Tests write only under ``tmp_path`` (per test, so per worker), never to fixed paths.
+# kernels most tests need once, before any worker starts; the workers then load numba's on-disk
+# cache. Compiling is single-threaded and takes minutes per planner (about 13 CPU-minutes for
+# everything below), so it runs as a few processes at once, each compiling its own planners
+# (a shared callee may be compiled twice; numba's cache writes are atomic). Tests write only
+# under ``tmp_path`` (per test, so per worker), never to fixed paths.
 
 
-def _warm_numba_cache() -> None:
-    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
+def _warm_scenario():
     from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    return load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml")
+
+
+def _warm_rrt_and_fuzzy_rrt() -> None:
+    from xfuzzy_rrt.fuzzy.rulebook import rulebooks_dir
     from xfuzzy_rrt.planners.api import plan_scenario
 
-    s = load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml")
+    s = _warm_scenario()
     plan_scenario(s, planner="rrt", seed=0, max_iter=20)
     for name in ("goal-frame", "expert"):
         plan_scenario(s, planner="fuzzy-rrt", rulebook=rulebooks_dir() / name, seed=0,
                       max_iter=20, trace=True)
+
+
+def _warm_connect_and_certificate() -> None:
+    from xfuzzy_rrt.planners.api import plan_scenario
+
+    s = _warm_scenario()
     plan_scenario(s, planner="fuzzy-rrt-connect", seed=0, max_iter=20, trace=True)
     # The certificate and the exact minimum clearance (measured lazily, so no plan above
     # compiled them): tests with a time limit must not pay for their first compile.
@@ -97,6 +155,49 @@ def _warm_numba_cache() -> None:
     a = s.arrays()
     certify_path(a, [s.start_deg, s.goal_deg])
     path_min_clearance(a, [s.start_deg, s.goal_deg])
+
+
+def _warm_training(mode: str) -> None:
+    """The GA's population kernel of one semantics (``iterations_for``)."""
+    import numpy as np
+
+    from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for
+    from xfuzzy_rrt.training.genome import decode, n_genes
+
+    knots, consts = decode(np.full((1, n_genes(mode)), 0.5), mode)
+    iterations_for([TrainingProblem.from_scenario(_warm_scenario())], knots, consts, mode,
+                   np.array([0]), 20)
+
+
+def _warm_goal_frame_training_generator_and_engine() -> None:
+    import numpy as np
+
+    from xfuzzy_rrt.fuzzy.engine import evaluate
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
+    from xfuzzy_rrt.scenarios.generate import generate_one
+
+    _warm_training("goal-frame")
+    generate_one(0, 0)
+    evaluate(*load_rulebook(rulebooks_dir() / "expert").arrays(), np.zeros((1, 4)))
+
+
+#: Each run in its own process by :func:`_warm_numba_cache`, all at once.
+_WARM_GROUPS = {
+    "rrt-and-fuzzy-rrt": _warm_rrt_and_fuzzy_rrt,
+    "connect-and-certificate": _warm_connect_and_certificate,
+    "paper-training": lambda: _warm_training("relative"),
+    "goal-frame-training": _warm_goal_frame_training_generator_and_engine,
+}
+
+
+def _warm_numba_cache() -> None:
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); import conftest; "
+            "conftest._WARM_GROUPS[sys.argv[2]]()")
+    procs = {name: subprocess.Popen([sys.executable, "-c", code, str(TESTS), name], cwd=PROJECT)
+             for name in _WARM_GROUPS}
+    failed = [name for name, proc in procs.items() if proc.wait() != 0]
+    if failed:
+        raise RuntimeError(f"warming the numba cache failed ({', '.join(failed)}); see above")
 
 
 def pytest_configure(config):

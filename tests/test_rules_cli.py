@@ -11,7 +11,14 @@ from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 from xfuzzy_rrt.fuzzy.variables import INPUTS, OUTPUTS, rule_terms
 
 from _rulebook_helpers import EXPERT, copy_expert, random_inputs
-from conftest import PROJECT
+from conftest import PROJECT, run_main
+
+
+@pytest.fixture
+def run_cli():
+    """The CLI through ``main(argv)`` in this process (``conftest.run_main``): these tests
+    check what commands print, return and write, not the process; ~1.5 s less a call."""
+    return run_main
 
 
 def _write_inputs(path, X):

@@ -9,7 +9,7 @@ of the normal run, because nothing else notices a file missing from the wheel.
 Compiling every kernel again in the fresh site-packages took 8 of the suite's minutes on two
 busy cores and proves nothing about packaging (numba keys its cache on a hash of each source
 file's bytes, so the checkout's cache is valid for the byte-identical installed copy). So the
-installed copy starts from the checkout's numba cache, minus the entries of ``extract_path``
+installed copy starts from the checkout's numba cache, minus the entries of ``finish_tree_run``
 (a small kernel ``plan`` calls from Python): the first ``plan`` still compiles in the fresh
 site-packages, must say so on exactly one line and must leave that kernel cached there for
 the next command. Kernels the checkout has not compiled yet are simply compiled by the
@@ -96,7 +96,7 @@ def installed(wheel, tmp_path_factory) -> Path:
 
 
 #: Cache entries left out of the seed, so that the installed copy's first ``plan`` compiles.
-UNSEEDED = "tree.extract_path-"
+UNSEEDED = "result.finish_tree_run-"
 
 
 def _seed_numba_cache(package: Path) -> None:

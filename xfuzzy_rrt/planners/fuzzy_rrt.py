@@ -72,7 +72,7 @@ from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
 from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import exact, lookup, remember, rulebook_token
+from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
 from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, nearest, reset_tree
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
@@ -351,12 +351,9 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
     resolves to the same object (a call without a time budget or a trace)."""
     key = ("fuzzy-rrt", id(scenario), rulebook_token(rulebook), exact(max_iter),
            exact(min_step_deg), exact(margin), exact(clearance_m))
-    hit = lookup(key, scenario)
-    if hit is not None and _resolve_rulebook(rulebook) is hit.rb:
-        return hit
-    setup = _prepare(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m, None)
-    remember(key, scenario, setup)
-    return setup
+    return remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
+                                                      margin, clearance_m, None),
+                      lambda hit: _resolve_rulebook(rulebook) is hit.rb)
 
 
 #: The stop flag of a call without a time budget: kernels only read it, nothing raises it.

@@ -28,7 +28,7 @@ from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_resu
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import empty_tree, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import exact, lookup, remember
+from xfuzzy_rrt.planners.setup_memo import exact, remembered
 from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, nearest, reset_tree
 
 DEFAULT_STEP_DEG = default("rrt", "step_deg")
@@ -104,12 +104,8 @@ def _setup_for(scenario: Scenario, max_iter, step_deg, goal_bias, margin,
     """:func:`_prepare`, remembered per scenario object and settings (no time budget)."""
     key = ("rrt", id(scenario), exact(max_iter), exact(step_deg), exact(goal_bias),
            exact(margin), exact(clearance_m))
-    hit = lookup(key, scenario)
-    if hit is not None:
-        return hit
-    setup = _prepare(scenario, max_iter, step_deg, goal_bias, margin, clearance_m, None)
-    remember(key, scenario, setup)
-    return setup
+    return remembered(key, scenario, lambda: _prepare(scenario, max_iter, step_deg, goal_bias,
+                                                      margin, clearance_m, None))
 
 
 #: The stop flag of a call without a time budget: the kernel only reads it.

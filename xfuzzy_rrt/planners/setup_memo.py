@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import weakref
-from typing import Any, Hashable
+from typing import Any, Callable, Hashable
 
 #: Set-ups kept (each a few small arrays and references to shared, immutable objects).
 MAX_ENTRIES = 128
@@ -87,6 +87,19 @@ def remember(key: Hashable, scenario: Any, setup: Any) -> None:
             del _memo[next(iter(_memo))]
         except (KeyError, StopIteration, RuntimeError):  # another thread trimmed it first
             break
+
+
+def remembered(key: Hashable, scenario: Any, prepare: Callable[[], Any],
+               still_valid: Callable[[Any], bool] | None = None) -> Any:
+    """The set-up remembered for ``key`` and this ``scenario`` if ``still_valid(it)`` (e.g. the
+    rulebook still resolves to the object it was built for), else ``prepare()``, remembered.
+    ``prepare`` runs every check, so an error is raised, not remembered."""
+    hit = lookup(key, scenario)
+    if hit is not None and (still_valid is None or still_valid(hit)):
+        return hit
+    setup = prepare()
+    remember(key, scenario, setup)
+    return setup
 
 
 def clear() -> None:

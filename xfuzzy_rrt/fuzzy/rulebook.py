@@ -319,7 +319,7 @@ def shipped_rulebook_str(name: str = DEFAULT_RULEBOOK) -> str:
 
 def default_rulebook_str() -> str:
     """:func:`default_rulebook_path` as :func:`shipped_rulebook_str` gives it."""
-    return _shipped_dir_str(os.environ.get(RULEBOOKS_ENV) or None, DEFAULT_RULEBOOK)
+    return shipped_rulebook_str(DEFAULT_RULEBOOK)
 
 
 def _content_key(root: Path) -> str:

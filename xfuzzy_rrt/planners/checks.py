@@ -22,6 +22,21 @@ def check_dof(scenario: Scenario) -> None:
             raise InputError(where, f"{which}: {len(q)} angles for {scenario.dof} joints")
 
 
+def check_plan_call(planner: str, scenario: Scenario, max_iter, margin, clearance_m,
+                    **given) -> tuple[float, dict]:
+    """The checks every tree planner's call opens with, in the order their errors are reported:
+    the arms' joints, the clearance (against the start and goal), ``max_iter``, then every
+    parameter of ``planner`` (``given``, with ``max_iter``). Returns the kernels' margin and
+    the resolved parameters (:func:`~xfuzzy_rrt.planners.params.resolve_params`)."""
+    from xfuzzy_rrt.geometry.clearance import planning_margin
+    from xfuzzy_rrt.planners.params import resolve_params
+
+    check_dof(scenario)
+    margin = planning_margin(scenario, clearance_m, margin)
+    check_max_iter(max_iter)
+    return margin, resolve_params(planner, max_iter=max_iter, **given)
+
+
 def check_positive(name: str, value: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
         raise InputError(name, f"must be a positive number, got {value!r}")

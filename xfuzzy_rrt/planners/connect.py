@@ -74,10 +74,9 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.semantics import length_scale
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
-from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.collision import clearance_kernel
 from xfuzzy_rrt.geometry.scenario import Scenario
-from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
+from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend
 from xfuzzy_rrt.planners.goal_frame import (
     REJECT_DECAY,
@@ -85,7 +84,6 @@ from xfuzzy_rrt.planners.goal_frame import (
     problem_lever,
     sample_goal_frame,
 )
-from xfuzzy_rrt.planners.params import resolve_params
 from xfuzzy_rrt.planners.result import (
     ACCEPTED,
     EDGE_BLOCKED,
@@ -98,7 +96,7 @@ from xfuzzy_rrt.planners.result import (
     vertices_within,
 )
 from xfuzzy_rrt.planners.rng import seed_state
-from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
+from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
@@ -389,11 +387,8 @@ class _Setup(NamedTuple):
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
              max_time_s) -> _Setup:
     """Every check of a call, in the order errors are reported, and what the kernel takes."""
-    check_dof(scenario)
-    margin = planning_margin(scenario, clearance_m, margin)
-    check_max_iter(max_iter)
-    params = resolve_params("fuzzy-rrt", max_iter=max_iter, max_time_s=max_time_s,
-                            min_step_deg=min_step_deg)
+    margin, params = check_plan_call("fuzzy-rrt", scenario, max_iter, margin, clearance_m,
+                                     max_time_s=max_time_s, min_step_deg=min_step_deg)
     rb = _resolve_rulebook(rulebook)
     check_connect_rulebook(rb, scenario)
     knots, consts = rb.compiled
@@ -415,10 +410,6 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
     return remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
                                                       margin, clearance_m, None),
                       lambda hit: _resolve_rulebook(rulebook) is hit.rb)
-
-
-#: The stop flag of a call without a time budget: the kernel only reads it.
-_NEVER_STOPPED = np.zeros(1, dtype=np.int64)
 
 
 def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
@@ -463,7 +454,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
                 "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
     if max_time_s is None:
         t0 = time.perf_counter()
-        ok, iterations, last_a, last_b = run(max_iter, _NEVER_STOPPED)
+        ok, iterations, last_a, last_b = run(max_iter, NEVER_STOPPED)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
         meta_a, meta_b = ta.meta.copy(), tb.meta.copy()

@@ -57,19 +57,18 @@ import numpy as np
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
-from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.collision import direction_and_distance, nearest_obstacle_for_arm
 from xfuzzy_rrt.geometry.kinematics import arm_end_effector
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.geometry.scenario import Scenario
-from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
+from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
-from xfuzzy_rrt.planners.params import default, resolve_params
+from xfuzzy_rrt.planners.params import default
 from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
                                          finish_tree_run, replace_result)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
-from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
+from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
 from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
@@ -328,11 +327,8 @@ class _Setup(NamedTuple):
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
              max_time_s) -> _Setup:
     """Every check of a call, in the order errors are reported, and what the kernel takes."""
-    check_dof(scenario)
-    margin = planning_margin(scenario, clearance_m, margin)
-    check_max_iter(max_iter)
-    params = resolve_params("fuzzy-rrt", max_iter=max_iter, max_time_s=max_time_s,
-                            min_step_deg=min_step_deg)
+    margin, params = check_plan_call("fuzzy-rrt", scenario, max_iter, margin, clearance_m,
+                                     max_time_s=max_time_s, min_step_deg=min_step_deg)
     rb = _resolve_rulebook(rulebook)
     check_rulebook_fits(rb, scenario)
     knots, consts = rb.compiled
@@ -354,10 +350,6 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
     return remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
                                                       margin, clearance_m, None),
                       lambda hit: _resolve_rulebook(rulebook) is hit.rb)
-
-
-#: The stop flag of a call without a time budget: kernels only read it, nothing raises it.
-_NEVER_STOPPED = np.zeros(1, dtype=np.int64)
 
 
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,
@@ -390,7 +382,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     if max_time_s is None:
         t0 = time.perf_counter()
         ok, iterations, last = kernel(problem, tuple(tree), int(seed), max_iter, knots, consts,
-                                      mode, setup.min_step, _NEVER_STOPPED, bool(trace),
+                                      mode, setup.min_step, NEVER_STOPPED, bool(trace),
                                       buffers)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first

@@ -17,16 +17,15 @@ from typing import Any, NamedTuple
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.geometry.clearance import planning_margin
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.geometry.scenario import Scenario
-from xfuzzy_rrt.planners.checks import check_dof, check_max_iter
+from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend
-from xfuzzy_rrt.planners.params import default, resolve_params
+from xfuzzy_rrt.planners.params import default
 from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
                                          finish_tree_run)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
-from xfuzzy_rrt.planners.termination import StopFlag, stopped_by
+from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import empty_tree, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import exact, remembered
 from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, nearest, reset_tree
@@ -88,11 +87,9 @@ class _Setup(NamedTuple):
 def _prepare(scenario: Scenario, max_iter, step_deg, goal_bias, margin, clearance_m,
              max_time_s) -> _Setup:
     """Every check of a call, in the order errors are reported, and what the kernel takes."""
-    check_dof(scenario)
-    margin = planning_margin(scenario, clearance_m, margin)
-    check_max_iter(max_iter)
-    params = resolve_params("rrt", max_iter=max_iter, max_time_s=max_time_s,
-                            step_deg=step_deg, goal_bias=goal_bias)
+    margin, params = check_plan_call("rrt", scenario, max_iter, margin, clearance_m,
+                                     max_time_s=max_time_s, step_deg=step_deg,
+                                     goal_bias=goal_bias)
     a = scenario_arrays(scenario)
     recorded = {"step_deg": float(params["step_deg"]), "goal_bias": float(params["goal_bias"]),
                 "max_iter": int(params["max_iter"]), "margin_m": float(margin)}
@@ -106,10 +103,6 @@ def _setup_for(scenario: Scenario, max_iter, step_deg, goal_bias, margin,
            exact(margin), exact(clearance_m))
     return remembered(key, scenario, lambda: _prepare(scenario, max_iter, step_deg, goal_bias,
                                                       margin, clearance_m, None))
-
-
-#: The stop flag of a call without a time budget: the kernel only reads it.
-_NEVER_STOPPED = np.zeros(1, dtype=np.int64)
 
 
 def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER,
@@ -136,7 +129,7 @@ def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER
     if max_time_s is None:
         t0 = time.perf_counter()
         ok, iterations, last = rrt_entry(problem, tuple(tree), int(seed), max_iter, step, bias,
-                                         _NEVER_STOPPED)
+                                         NEVER_STOPPED)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
         meta0 = tree.meta.copy()

@@ -60,6 +60,12 @@ def check_max_time(max_time_s, where: str = "--max-time") -> float:
     return t
 
 
+#: The stop flag of a call without a time budget: kernels only read it and nothing raises it,
+#: so every such call (any thread) shares this one array (kept writable: numba types a
+#: read-only array differently and would compile every kernel a second time).
+NEVER_STOPPED = np.zeros(1, dtype=np.int64)
+
+
 class StopFlag:
     """The flag a kernel polls; raised by a timer thread after ``max_time_s`` (if any).
 

@@ -11,10 +11,13 @@ each worker prints where it imported ``xfuzzy_rrt`` from, and the script refuses
 that is not the tree it asked for. The measure is the planner's own kernel timer
 (``PlanResult.wall_s``); both versions must need the same iterations (same seeds, same
 results), else the line is flagged. Printed: per planner and problem the median kernel time of
-both and their ratio, then the geometric mean of the ratios per planner.
+both and their ratio, the ratio of their deterministic work counts (``PlanResult.work``, summed
+over the seeds; ``-`` when a version does not count), then the geometric mean of the time
+ratios per planner.
 
     nice python benchmarks/regression.py                       # 8782882, paper-reference + 12
     nice python benchmarks/regression.py --problems /tmp/eval9100 --count 24 --seeds 10
+    python benchmarks/regression.py --commit HEAD~1 --problems /tmp/dof5 --planners fuzzy-rrt
 """
 
 from __future__ import annotations
@@ -47,7 +50,8 @@ for line in sys.stdin:
         r = plan_scenario(s, job["planner"], seed=job["seed"])
         walls.append(r.wall_s)
     print(json.dumps({"wall": min(walls), "iterations": r.iterations,
-                      "success": bool(r.success)}), flush=True)
+                      "success": bool(r.success), "work": getattr(r, "work", None)}),
+          flush=True)
 """
 
 
@@ -112,14 +116,18 @@ def main(argv=None) -> int:
     finally:
         old.close()
         new.close()
-    print(f"{'planner':<10} {'problem':<16} {'old ms':>8} {'new ms':>8} {'new/old':>8}  iterations")
+    print(f"{'planner':<10} {'problem':<24} {'old ms':>8} {'new ms':>8} {'new/old':>8} "
+          f"{'work new/old':>12}  iterations")
     logs = {p: [] for p in planners}
     for (p, name), pairs in rows.items():
         o = statistics.median(a["wall"] for a, _ in pairs) * 1e3
         n = statistics.median(b["wall"] for _, b in pairs) * 1e3
         same = all(a["iterations"] == b["iterations"] for a, b in pairs)
         logs[p].append(math.log(n / o))
-        print(f"{p:<10} {name:<16} {o:>8.3f} {n:>8.3f} {n / o:>8.2f}  "
+        works = [(a["work"], b["work"]) for a, b in pairs if a["work"] and b["work"]]
+        work = (f"{sum(b for _, b in works) / sum(a for a, _ in works):>12.3f}" if works
+                else f"{'-':>12}")
+        print(f"{p:<10} {name:<24} {o:>8.3f} {n:>8.3f} {n / o:>8.2f} {work}  "
               f"{'same' if same else 'DIFFERENT'}")
     for p in planners:
         print(f"{p}: geometric mean new/old = {math.exp(statistics.fmean(logs[p])):.2f} "

@@ -58,8 +58,10 @@ DEFAULT_FAMILIES = ("sample", "hard", "mira")
 DEFAULT_PROBLEMS = 16
 DEFAULT_RUNS = 10
 DEFAULT_MAX_ITER = 10_000
-#: Values searched: steps/ranges from half the paper's 10° to a third of a turn.
-STEPS_DEG = (5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0, 120.0)
+#: Values searched: steps/ranges from half the paper's 10° to two thirds of a turn. (Up to
+#: 120° until blocked edges became cheap to reject, issue 24: RRT's best step then moved to
+#: 120°, the edge of that grid, so the grid grew past it.)
+STEPS_DEG = (5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0, 120.0, 180.0, 240.0)
 GOAL_BIASES = (0.0, 0.05, 0.1, 0.2, 0.3)
 #: Planner code the tuning numbers depend on (hashed into the provenance).
 CODE_FILES = ("planners/rrt.py", "planners/extend.py", "planners/tree.py", "planners/rng.py",

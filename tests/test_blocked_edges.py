@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from xfuzzy_rrt.geometry.collision import (
-    CERT_MARGIN_M,
+    clearance_of_margin,
     config_free,
     edge_free,
     edge_free_two_link,
@@ -124,7 +124,7 @@ def _sweep_past_circle(gap, clearance=0.0, dof=2):
     margin = effective_margin(clearance)
     links = np.full(dof, 0.35 / dof)
     r = 0.02
-    clear = margin - CERT_MARGIN_M if margin > CERT_MARGIN_M else 0.0
+    clear = clearance_of_margin(margin)
     cx = 0.35 + RADIUS + clear + gap + r
     P = single_arm_problem(links, (0.0, 0.0), RADIUS, np.array([[0.0, cx, 0.0, r, 0.0]]),
                            np.tile([-180.0, 180.0], (dof, 1)), margin=margin)

@@ -499,6 +499,33 @@ def probe_point(s, f, s1, f1, s0, f0, ds):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
+def probe_start(probe):
+    """A fresh probe schedule for one edge: ``(s1, f1, s0, f0, failed, wait)``, the last two
+    stops (none yet), the probes that found free space and the stops to wait before the next.
+    ``probe=False`` starts it spent: conservative advancement alone."""
+    return 0.0, np.inf, 0.0, np.inf, 0 if probe else PROBE_BUDGET, 0
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def probe_next(sched, s, f, ds):
+    """At a stop ``s`` with free distance ``f`` and advance ``ds``: where to probe (-1.0:
+    nowhere; :func:`probe_point`) and the schedule with this stop remembered."""
+    s1, f1, s0, f0, failed, wait = sched
+    if failed >= PROBE_BUDGET:
+        return -1.0, sched
+    at = probe_point(s, f, s1, f1, s0, f0, ds) if wait == 0 else -1.0
+    return at, (s, f, s1, f1, failed, max(wait - 1, 0))
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def probe_missed(sched):
+    """The schedule after a probe found free space: one more failure, and the next probe waits
+    ``2 ** failed - 1`` stops."""
+    s1, f1, s0, f0, failed, _ = sched
+    return s1, f1, s0, f0, failed + 1, (1 << (failed + 1)) - 1
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
 def two_link_clearances(P, q0_deg, q1_deg):
     """Clearance of each link of ONE two-link arm (``P`` has one arm of two links) at the joint
     angles ``(q0_deg, q1_deg)``: :func:`clearance_kernel`'s per-link values, same arithmetic,
@@ -538,12 +565,7 @@ def edge_free_two_link(P, qa_deg, qb_deg, margin, ca0, ca1, cb0, cb1, probe=True
     per_stop = n_distance_pairs(P)
     s = 0.0
     first = True
-    s_prev = 0.0
-    f_prev = np.inf
-    s_prev0 = 0.0
-    f_prev0 = np.inf
-    failed = 0 if probe else PROBE_BUDGET
-    wait = 0
+    sched = probe_start(probe)
     while True:
         P.work[0] += per_stop
         if s >= 1.0 and cb0 == cb0:
@@ -586,22 +608,14 @@ def edge_free_two_link(P, qa_deg, qb_deg, margin, ca0, ca1, cb0, cb1, probe=True
             return False, ca0, ca1
         if s >= 1.0:
             return True, ca0, ca1
-        if failed < PROBE_BUDGET:
-            at = (probe_point(s, cmin - clear, s_prev, f_prev, s_prev0, f_prev0, ds)
-                  if wait == 0 else -1.0)
-            wait = max(wait - 1, 0)
-            if at > 0.0:
-                P.work[0] += per_stop
-                p0, p1 = two_link_clearances(P, qa_deg[0] + at * (qb_deg[0] - qa_deg[0]),
-                                             qa_deg[1] + at * (qb_deg[1] - qa_deg[1]))
-                if p0 <= clear or p1 <= clear:
-                    return False, ca0, ca1
-                failed += 1
-                wait = (1 << failed) - 1
-            s_prev0 = s_prev
-            f_prev0 = f_prev
-            s_prev = s
-            f_prev = cmin - clear
+        at, sched = probe_next(sched, s, cmin - clear, ds)
+        if at > 0.0:
+            P.work[0] += per_stop
+            p0, p1 = two_link_clearances(P, qa_deg[0] + at * (qb_deg[0] - qa_deg[0]),
+                                         qa_deg[1] + at * (qb_deg[1] - qa_deg[1]))
+            if p0 <= clear or p1 <= clear:
+                return False, ca0, ca1
+            sched = probe_missed(sched)
         s += ds
         if s > 1.0:
             s = 1.0
@@ -747,12 +761,7 @@ def _edge_free(P, qa_deg, qb_deg, margin, probe):
                     msf[k, m] = self_pair_motion_bound(P.links, qa_deg, qb_deg, k, m)
     per_stop = n_distance_pairs(P)
     s = 0.0
-    s_prev = 0.0
-    f_prev = np.inf
-    s_prev0 = 0.0
-    f_prev0 = np.inf
-    failed = 0 if probe else PROBE_BUDGET
-    wait = 0
+    sched = probe_start(probe)
     while True:
         P.work[0] += per_stop
         # Per-pair clearance at q(s) and the safe advance it buys.
@@ -764,22 +773,14 @@ def _edge_free(P, qa_deg, qb_deg, margin, probe):
             return False
         if s >= 1.0:
             return True
-        if failed < PROBE_BUDGET:
-            at = (probe_point(s, cmin - clear, s_prev, f_prev, s_prev0, f_prev0, ds)
-                  if wait == 0 else -1.0)
-            wait = max(wait - 1, 0)
-            if at > 0.0:
-                P.work[0] += per_stop
-                finite, c_at, _ = _edge_stop(P, qa_deg, qb_deg, at, mks, msf, seg, clear,
-                                             n_arms, need_seg, has_obstacles, has_self)
-                if finite and c_at <= clear:
-                    return False
-                failed += 1
-                wait = (1 << failed) - 1
-            s_prev0 = s_prev
-            f_prev0 = f_prev
-            s_prev = s
-            f_prev = cmin - clear
+        at, sched = probe_next(sched, s, cmin - clear, ds)
+        if at > 0.0:
+            P.work[0] += per_stop
+            finite, c_at, _ = _edge_stop(P, qa_deg, qb_deg, at, mks, msf, seg, clear, n_arms,
+                                         need_seg, has_obstacles, has_self)
+            if finite and c_at <= clear:
+                return False
+            sched = probe_missed(sched)
         s += ds
         if s > 1.0:
             s = 1.0

@@ -26,7 +26,7 @@ import sys
 import time
 from pathlib import Path
 
-PLANNERS = ("fuzzy-rrt", "rrt")
+PLANNERS = ("fuzzy-rrt", "rrt", "rrt:tuned")  # the default, the paper's peer, the fair peer
 
 
 def _load(paths):

@@ -134,6 +134,25 @@ def test_rrt_tuned_without_its_file_is_one_error_line(monkeypatch, tmp_path, cap
     assert len(err) == 1 and err[0].startswith("error: --planner: rrt:tuned needs the tuned file")
 
 
+def test_tuned_parameters_are_reread_when_their_file_changes_even_at_the_same_size_and_mtime(
+        monkeypatch, tmp_path):
+    import os
+
+    from xfuzzy_rrt.planners import tuned
+
+    monkeypatch.setattr(tuned, "tuned_dir", lambda: tmp_path)
+    f = tmp_path / "rrt.toml"
+    f.write_text("[params]\nstep_deg = 60.0\ngoal_bias = 0.1\n")
+    assert tuned.tuned_params("rrt") == {"step_deg": 60.0, "goal_bias": 0.1}
+    before = f.stat()
+    f.write_text("[params]\nstep_deg = 70.0\ngoal_bias = 0.1\n")  # same size
+    os.utime(f, ns=(before.st_atime_ns, before.st_mtime_ns))  # mtime restored; ctime moves on
+    assert f.stat().st_size == before.st_size and f.stat().st_mtime_ns == before.st_mtime_ns
+    assert tuned.tuned_params("rrt") == {"step_deg": 70.0, "goal_bias": 0.1}
+    f.unlink()
+    assert tuned.tuned_params("rrt") is None
+
+
 # ------------------------------------------------------------------------------ tuning
 
 

@@ -2,8 +2,8 @@
 
 A goal-frame rulebook lints, round-trips through its text and FLL, plans deterministically with
 certified paths, traces every decision and explains it with numbers equal to the trace; its GA
-training with the log-ratio fitness and held-out validation reproduces across worker counts and
-Dask; and the protocol command reports ratios that follow from its own runs table.
+training with the log-ratio and work-cvar fitnesses and held-out validation reproduces across
+worker counts and Dask; and the protocol command reports ratios that follow from its own runs table.
 """
 
 from __future__ import annotations
@@ -218,15 +218,17 @@ def test_compiled_goal_frame_evaluation_matches_the_planner_run_for_run():
                 assert its[p, k, r] == (res.iterations if res.success else -1)
 
 
-def _train(cwd: Path, *extra: str) -> subprocess.CompletedProcess:
+def _train(cwd: Path, *extra: str, fitness: str = "log-ratio") -> subprocess.CompletedProcess:
     args = [console_script(), "train", "--scenario", str(SCENARIOS[0]),
             "--validation-scenario", str(SCENARIOS[1]), "--bounds", "goal-frame",
-            "--fitness", "log-ratio", "--population", "10", "--generations", "3",
+            "--fitness", fitness, "--population", "10", "--generations", "3",
             "--runs-per-eval", "2", "--validation-runs", "2", "--seed", "5", "--out", "rb", *extra]
     return subprocess.run(args, cwd=cwd, capture_output=True, text=True, timeout=600)
 
 
-def test_log_ratio_training_with_validation_reproduces_across_workers_and_dask(tmp_path):
+@pytest.mark.parametrize("fitness,baseline", [("log-ratio", "baseline_iterations"),
+                                              ("work-cvar", "baseline_work")])
+def test_training_with_validation_reproduces_across_workers_and_dask(tmp_path, fitness, baseline):
     distributed = pytest.importorskip("distributed")
     outputs = {}
 
@@ -238,21 +240,21 @@ def test_log_ratio_training_with_validation_reproduces_across_workers_and_dask(t
 
     for label, extra in (("one", ["--workers", "1"]), ("two", ["--workers", "2"])):
         (tmp_path / label).mkdir()
-        proc = _train(tmp_path / label, *extra)
+        proc = _train(tmp_path / label, *extra, fitness=fitness)
         assert proc.returncode == 0, proc.stderr
         outputs[label] = collect(label)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
                                   protocol="tcp://", host="127.0.0.1", dashboard_address=None) as cluster:
         (tmp_path / "dask").mkdir()
-        proc = _train(tmp_path / "dask", "--scheduler", cluster.scheduler_address)
+        proc = _train(tmp_path / "dask", "--scheduler", cluster.scheduler_address, fitness=fitness)
         assert proc.returncode == 0, proc.stderr
         outputs["dask"] = collect("dask")
     files, hist = outputs["one"]
     assert hist["validation_fitness"].notna().all()  # the train / validation gap per generation
     manifest = files["rulebook.toml"].decode()
-    assert 'semantics = "goal-frame"' in manifest and 'fitness = "log-ratio"' in manifest
-    assert "baseline_iterations" in manifest and "validation_scenarios" in manifest
-    assert "--validation-scenario" in manifest and "--fitness log-ratio" in manifest
+    assert 'semantics = "goal-frame"' in manifest and f'fitness = "{fitness}"' in manifest
+    assert baseline in manifest and "validation_scenarios" in manifest
+    assert "--validation-scenario" in manifest and f"--fitness {fitness}" in manifest
     for label in ("two", "dask"):
         assert outputs[label][0] == files, label
         pd.testing.assert_frame_equal(outputs[label][1], hist)

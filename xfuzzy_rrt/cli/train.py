@@ -65,14 +65,14 @@ def train(
     population: int = typer.Option(400, "--population", help="Individuals per generation (paper: 400)."),
     generations: int = typer.Option(50, "--generations", help="Maximum generations (paper: 50)."),
     runs_per_eval: int = typer.Option(5, "--runs-per-eval", help="Planner runs per scenario per individual (paper: 5)."),
-    target_fitness: Optional[float] = typer.Option(None, "--target-fitness", help="Stop when the best fitness reaches this (default: the paper's 9750 with --fitness paper; never with log-ratio)."),
+    target_fitness: Optional[float] = typer.Option(None, "--target-fitness", help="Stop when the best fitness reaches this (default: the paper's 9750 with --fitness paper; never with log-ratio or work-cvar)."),
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Seed: the result depends only on it and the inputs."),
     workers: Optional[int] = typer.Option(None, "--workers", callback=check_workers_option, help="Local worker processes (default: all cores; 1 = in-process)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address (tcp://HOST:PORT): evaluate there."),
     out: Path = typer.Option(..., "--out", help="Rulebook directory to write (also history.csv and checkpoint/)."),
     resume: bool = typer.Option(False, "--resume", help="Continue from OUT/checkpoint after an interruption."),
     bounds: str = typer.Option("absolute", "--bounds", help="Planner semantics: absolute or relative bounds (the paper's semantics), or goal-frame."),
-    fitness: str = typer.Option("paper", "--fitness", help="paper (mean of 10000 - iterations, -100 on failure) or log-ratio (mean log of RRT's median / iterations per problem)."),
+    fitness: str = typer.Option("paper", "--fitness", help="paper (mean of 10000 - iterations, -100 on failure), log-ratio (mean log of RRT's median / iterations per problem) or work-cvar (goal-frame semantics: log of the tuned RRT's median work / work per problem, half its mean plus half the mean of the worst quarter of problems)."),
     validation_scenario: List[Path] = typer.Option([], "--validation-scenario", help="Held-out scenario file or directory (repeatable): picks the final rulebook, gives the train/validation gap."),
     max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run (reward = max_iter - iterations)."),
     elite: int = typer.Option(8, "--elite", help="Best individuals copied unchanged into the next generation."),
@@ -121,11 +121,12 @@ def train(
     if target_fitness is None:
         target_fitness = 9750.0 if fitness == "paper" else 1e9
     base = v_base = ()
-    if fitness == "log-ratio":
-        typer.echo(f"computing RRT's median iterations on {len(scenarios) + len(held_out)} "
-                   "scenario(s) (the log-ratio baseline)", err=True)
-        base = baselines(scenarios, max_iter)
-        v_base = baselines(held_out, max_iter) if held_out else ()
+    if fitness in ("log-ratio", "work-cvar"):
+        what = "RRT's median iterations" if fitness == "log-ratio" else "the tuned RRT's median work"
+        typer.echo(f"computing {what} on {len(scenarios) + len(held_out)} "
+                   f"scenario(s) (the {fitness} baseline)", err=True)
+        base = baselines(scenarios, max_iter, fitness)
+        v_base = baselines(held_out, max_iter, fitness) if held_out else ()
     config = GAConfig(
         population=population, generations=generations, runs_per_eval=runs_per_eval,
         target_fitness=target_fitness, seed=seed, bounds=bounds, max_iter=max_iter, elite=elite,

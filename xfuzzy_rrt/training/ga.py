@@ -45,7 +45,7 @@ import numpy as np
 
 from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.fuzzy.variables import N_RULES
-from xfuzzy_rrt.training.evaluate import FITNESSES, score
+from xfuzzy_rrt.training.evaluate import FITNESSES, iterations_of, score
 from xfuzzy_rrt.training.genome import (
     GENES_PER_FIS,
     MF_GENES,
@@ -83,8 +83,9 @@ class GAConfig:
     init: str = "seeded"
     validation_runs: int = 50
     scenarios: tuple[tuple[str, str], ...] = ()  # (name, sha256) of each training scenario
-    fitness: str = "paper"  # or "log-ratio" (see .evaluate.log_ratio_fitness)
-    baseline: tuple[float, ...] = ()  # RRT median iterations per training scenario (log-ratio)
+    fitness: str = "paper"  # or "log-ratio", "work-cvar" (see .evaluate.score)
+    # per training scenario: RRT's median iterations (log-ratio) or the tuned RRT's median work (work-cvar)
+    baseline: tuple[float, ...] = ()
     validation: tuple[tuple[str, str], ...] = ()  # held-out scenarios that pick the final rulebook
     validation_baseline: tuple[float, ...] = ()
     #: ``--clearance``: the certified margin (m) every training run must keep; ``None``: each
@@ -117,11 +118,16 @@ class GAConfig:
         need(0 <= self.seed < 2**63, "--seed", f"must lie in [0, 2^63), got {self.seed}")
         need(self.bounds in MODES, "--bounds", f"must be one of {', '.join(MODES)}, got {self.bounds!r}")
         need(self.fitness in FITNESSES, "--fitness", f"must be one of {', '.join(FITNESSES)}, got {self.fitness!r}")
-        if self.fitness == "log-ratio":
+        if self.fitness in ("log-ratio", "work-cvar"):
+            what = "RRT's median iterations" if self.fitness == "log-ratio" else "the tuned RRT's median work"
             need(len(self.baseline) == len(self.scenarios) and all(b > 0 for b in self.baseline),
-                 "--fitness", "log-ratio needs RRT's positive median iterations for every training scenario")
+                 "--fitness", f"{self.fitness} needs {what} (positive) for every training scenario")
             need(len(self.validation_baseline) == len(self.validation), "--validation-scenario",
-                 "log-ratio needs RRT's median iterations for every validation scenario")
+                 f"{self.fitness} needs {what} for every validation scenario")
+        need(self.fitness != "work-cvar" or _sem.of_mode(self.bounds).population.endswith(
+                 ":kernel_population"), "--fitness",
+             f"work-cvar counts the planner's work, which only the planner's own kernel "
+             f"spends: train it with --bounds goal-frame, not {self.bounds}")
         need(1 <= self.max_iter <= 1_000_000, "--max-iter", f"must lie in [1, 1000000], got {self.max_iter}")
         need(0 <= self.elite < self.population, "--elite", f"must lie in [0, population), got {self.elite}")
         need(2 <= self.tournament <= self.population, "--tournament", f"must lie in [2, population], got {self.tournament}")
@@ -182,6 +188,11 @@ GOAL_FRAME_SEEDS = (
     (0.2, 0.3, 90.0, 30.0, 60.0, 15.0),
     (0.2, 0.2, 120.0, 40.0, 90.0, 10.0),
     (0.3, 0.5, 60.0, 20.0, 45.0, 20.0),
+    # long steps: blocked edges are rejected cheaply (geometry.collision's probes), so the
+    # tuned RRT plans fastest at 180°; these start the search where the step range now reaches
+    (0.05, 1.0, 0.0, 0.0, 0.0, 90.0),  # the tuned RRT's kind of search, capped at 90°
+    (0.2, 0.3, 90.0, 30.0, 60.0, 60.0),
+    (0.3, 0.2, 120.0, 40.0, 90.0, 100.0),
 )
 
 
@@ -377,18 +388,19 @@ class Trainer:
         self.on_chunk = on_chunk
         self.validator = validator
 
-    def _fitness(self, its: np.ndarray, held_out: bool = False) -> np.ndarray:
+    def _fitness(self, runs: np.ndarray, held_out: bool = False) -> np.ndarray:
         c = self.config
         baseline = c.validation_baseline if held_out else c.baseline
-        return score(its, c.fitness, c.max_iter, np.asarray(baseline, dtype=np.float64))
+        return score(runs, c.fitness, c.max_iter, np.asarray(baseline, dtype=np.float64))
 
     def step(self, state: TrainState) -> TrainState:
         """Evaluate ``state.population``, record, stop or breed; return the next state."""
         c = self.config
         t0 = time.perf_counter()
         seeds = generation_seeds(c.seed, state.generation, c.runs_per_eval)
-        its = self.evaluator(state.population, seeds, self.on_chunk)
-        fit = self._fitness(its)
+        runs = self.evaluator(state.population, seeds, self.on_chunk)
+        fit = self._fitness(runs)
+        its = iterations_of(runs)
         best = int(np.lexsort((np.arange(len(fit)), -fit))[0])
         ok = (its >= 0) & (its < c.max_iter)
         best_its = np.where(ok[best], its[best], c.max_iter)
@@ -478,11 +490,12 @@ class Trainer:
                                chosen_from=f"hall of fame, generation {last + 1}", state=state)
         seeds = validation_seeds(c.seed, c.validation_runs)
         if self.validator is not None:
-            its = self.validator(genes, seeds, self.on_chunk)
-            fit = self._fitness(its, held_out=True)
+            runs = self.validator(genes, seeds, self.on_chunk)
+            fit = self._fitness(runs, held_out=True)
         else:
-            its = self.evaluator(genes, seeds, self.on_chunk)
-            fit = self._fitness(its)
+            runs = self.evaluator(genes, seeds, self.on_chunk)
+            fit = self._fitness(runs)
+        its = iterations_of(runs)
         best = int(np.lexsort((np.arange(len(fit)), -fit))[0])
         ok = (its[best] >= 0) & (its[best] < c.max_iter)
         return TrainResult(

@@ -249,14 +249,17 @@ def canonical_command(config: GAConfig, scenario_args: list[str], out: str,
     return " ".join(shlex.quote(a) for a in args)
 
 
-def baselines(scenarios: list[TrainingScenario], max_iter: int) -> tuple[float, ...]:
-    """RRT's median iterations on each scenario over seeds ``0..BASELINE_RUNS-1``."""
+def baselines(scenarios: list[TrainingScenario], max_iter: int,
+              fitness: str = "log-ratio") -> tuple[float, ...]:
+    """The fitness's reference on each scenario over seeds ``0..BASELINE_RUNS-1``: RRT's
+    median iterations (``log-ratio``) or the tuned RRT's median work (``work-cvar``)."""
     import numpy as np
 
-    from xfuzzy_rrt.training.evaluate import TrainingProblem, rrt_baseline
+    from xfuzzy_rrt.training.evaluate import TrainingProblem, rrt_baseline, tuned_rrt_baseline
 
     problems = [TrainingProblem.from_scenario(t.scenario) for t in scenarios]
-    return tuple(float(b) for b in rrt_baseline(problems, np.arange(BASELINE_RUNS), max_iter))
+    reference = tuned_rrt_baseline if fitness == "work-cvar" else rrt_baseline
+    return tuple(float(b) for b in reference(problems, np.arange(BASELINE_RUNS), max_iter))
 
 
 def history_frame(history: list[dict]):
@@ -320,6 +323,7 @@ def run_training(job: TrainJob,
     """Train (or resume), checkpointing every generation; write the rulebook at the end."""
     from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
     from xfuzzy_rrt.training.evaluate import TrainingProblem
+    from xfuzzy_rrt.training.evaluate import measure_of
     from xfuzzy_rrt.training.workers import make_evaluator
 
     job.check_out()
@@ -338,16 +342,18 @@ def run_training(job: TrainJob,
         if on_generation:
             on_generation(row)
 
+    measure = measure_of(config.fitness)
     # the engines first: a bad --scheduler or --workers fails before any folder is made
     with contextlib.ExitStack() as stack:
         evaluator = stack.enter_context(make_evaluator(problems, config.bounds, config.max_iter,
                                                        job.workers, job.scheduler,
-                                                       dof=config.dof))
+                                                       dof=config.dof, measure=measure))
         validator = None
         if held_out:
             validator = stack.enter_context(make_evaluator(held_out, config.bounds,
                                                            config.max_iter, job.workers,
-                                                           job.scheduler, dof=config.dof))
+                                                           job.scheduler, dof=config.dof,
+                                                           measure=measure))
         job.out.mkdir(parents=True, exist_ok=True)
         _remove_stale_temporaries(job)
         if on_start:
@@ -430,12 +436,22 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
         provenance["baseline"] = ("RRT median iterations per training scenario (seeds 0.."
                                   f"{BASELINE_RUNS - 1}, step 10 deg, goal bias 0.05)")
         provenance["baseline_iterations"] = [float(b) for b in c.baseline]
+    if c.fitness == "work-cvar":
+        from xfuzzy_rrt.planners.tuned import tuned_params
+
+        tuned = tuned_params("rrt") or {}
+        provenance["baseline"] = (f"rrt:tuned (data/tuned/rrt.toml: step {tuned.get('step_deg')} "
+                                  f"deg, goal bias {tuned.get('goal_bias')}) median work per "
+                                  f"training scenario (seeds 0..{BASELINE_RUNS - 1})")
+        provenance["baseline_work"] = [float(b) for b in c.baseline]
     if job.validation:
         provenance["validation_fitness_history"] = [float(r["validation_fitness"]) for r in history]
         provenance["validation_scenarios"] = [
             {"name": t.scenario.name, "file": t.path, "sha256": t.sha256} for t in job.validation]
         if c.fitness == "log-ratio":
             provenance["validation_baseline_iterations"] = [float(b) for b in c.validation_baseline]
+        if c.fitness == "work-cvar":
+            provenance["validation_baseline_work"] = [float(b) for b in c.validation_baseline]
     bounds_mode = c.bounds if c.bounds in BOUNDS_MODES else None  # only the paper's has one
     what = f"{c.bounds} bounds" if bounds_mode else f"{sem.name} semantics"
     description = (f"Trained by the genetic algorithm ({what}, {c.fitness} fitness) on "

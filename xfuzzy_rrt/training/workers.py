@@ -42,11 +42,13 @@ PR_SET_PDEATHSIG = 1
 
 
 def evaluate_chunk(genes: np.ndarray, problems: Sequence[TrainingProblem], bounds_mode: str,
-                   seeds: np.ndarray, max_iter: int, dof: int = 2) -> np.ndarray:
+                   seeds: np.ndarray, max_iter: int, dof: int = 2,
+                   measure: str = "iterations") -> np.ndarray:
     """Iterations int64[n, S, R] of the individuals ``genes`` [n, n_genes] (3,822 at 2 DOF;
-    *dof* fixes the genome's outputs and ranges, see :func:`~.genome.decode`)."""
+    *dof* fixes the genome's outputs and ranges, see :func:`~.genome.decode`), or with
+    ``measure="work"`` int64[n, S, R, 2] (iterations and work, :func:`~.evaluate.iterations_for`)."""
     knots, consts = decode(genes, bounds_mode, dof)
-    return iterations_for(list(problems), knots, consts, bounds_mode, seeds, max_iter)
+    return iterations_for(list(problems), knots, consts, bounds_mode, seeds, max_iter, measure)
 
 
 def die_with_parent(parent_pid: int) -> bool:
@@ -85,8 +87,8 @@ def _warm_in_worker(genes, bounds_mode, dof):
     evaluate_chunk(genes, _PROBLEMS[:1], bounds_mode, np.zeros(1, dtype=np.int64), 5, dof)
 
 
-def _evaluate_in_worker(genes, bounds_mode, seeds, max_iter, dof=2):
-    return evaluate_chunk(genes, _PROBLEMS, bounds_mode, seeds, max_iter, dof)
+def _evaluate_in_worker(genes, bounds_mode, seeds, max_iter, dof=2, measure="iterations"):
+    return evaluate_chunk(genes, _PROBLEMS, bounds_mode, seeds, max_iter, dof, measure)
 
 
 def _chunks(n: int, parts: int) -> list[slice]:
@@ -102,11 +104,18 @@ class Evaluator:
     finish (for the CLI's progress display). Use as a context manager to release workers.
     """
 
-    def __init__(self, problems: list[TrainingProblem], bounds_mode: str, max_iter: int, dof: int = 2):
+    def __init__(self, problems: list[TrainingProblem], bounds_mode: str, max_iter: int,
+                 dof: int = 2, measure: str = "iterations"):
         self.problems = list(problems)
         self.bounds_mode = bounds_mode
         self.max_iter = int(max_iter)
         self.dof = int(dof)  # the rulebook DOF the genomes encode
+        self.measure = measure  # what each run reports (evaluate.MEASURES)
+
+    def _out(self, genes: np.ndarray, seeds: np.ndarray) -> np.ndarray:
+        """The result array one call fills: [n, S, R], or [n, S, R, 2] for work."""
+        shape = (genes.shape[0], len(self.problems), len(seeds))
+        return np.empty(shape + ((2,) if self.measure == "work" else ()), dtype=np.int64)
 
     description = "in-process"
 
@@ -119,11 +128,11 @@ class Evaluator:
 
     def __call__(self, genes: np.ndarray, seeds: np.ndarray,
                  progress: Callable[[int, int], None] | None = None) -> np.ndarray:
-        out = np.empty((genes.shape[0], len(self.problems), len(seeds)), dtype=np.int64)
+        out = self._out(genes, seeds)
         parts = _chunks(genes.shape[0], CHUNKS_PER_WORKER)
         for k, sl in enumerate(parts):
             out[sl] = evaluate_chunk(genes[sl], self.problems, self.bounds_mode, seeds,
-                                     self.max_iter, self.dof)
+                                     self.max_iter, self.dof, self.measure)
             if progress:
                 progress(k + 1, len(parts))
         return out
@@ -141,18 +150,19 @@ class Evaluator:
 class ProcessEvaluator(Evaluator):
     """Local worker processes (the default: one per core)."""
 
-    def __init__(self, problems, bounds_mode, max_iter, workers: int, dof: int = 2):
-        super().__init__(problems, bounds_mode, max_iter, dof)
+    def __init__(self, problems, bounds_mode, max_iter, workers: int, dof: int = 2,
+                 measure: str = "iterations"):
+        super().__init__(problems, bounds_mode, max_iter, dof, measure)
         self.workers = int(workers)
         self.description = f"{self.workers} local worker processes"
         self._pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_init_worker,
                                          initargs=(self.problems, os.getpid()))
 
     def __call__(self, genes, seeds, progress=None):
-        out = np.empty((genes.shape[0], len(self.problems), len(seeds)), dtype=np.int64)
+        out = self._out(genes, seeds)
         parts = _chunks(genes.shape[0], CHUNKS_PER_WORKER * self.workers)
         futures = {self._pool.submit(_evaluate_in_worker, genes[sl], self.bounds_mode, seeds,
-                                     self.max_iter, self.dof): sl for sl in parts}
+                                     self.max_iter, self.dof, self.measure): sl for sl in parts}
         for k, fut in enumerate(as_completed(futures), start=1):
             out[futures[fut]] = fut.result()
             if progress:
@@ -203,8 +213,9 @@ def check_scheduler_address(address: str) -> None:
 class DaskEvaluator(Evaluator):
     """Tasks on a Dask distributed cluster (``--scheduler ADDRESS``)."""
 
-    def __init__(self, problems, bounds_mode, max_iter, address: str, dof: int = 2):
-        super().__init__(problems, bounds_mode, max_iter, dof)
+    def __init__(self, problems, bounds_mode, max_iter, address: str, dof: int = 2,
+                 measure: str = "iterations"):
+        super().__init__(problems, bounds_mode, max_iter, dof, measure)
         check_scheduler_address(address)
         from distributed import Client
 
@@ -221,12 +232,12 @@ class DaskEvaluator(Evaluator):
     def __call__(self, genes, seeds, progress=None):
         from distributed import as_completed
 
-        out = np.empty((genes.shape[0], len(self.problems), len(seeds)), dtype=np.int64)
+        out = self._out(genes, seeds)
         parts = _chunks(genes.shape[0], CHUNKS_PER_WORKER * self.workers)
         futures = []
         for sl in parts:
             fut = self._client.submit(evaluate_chunk, genes[sl], self._problems, self.bounds_mode,
-                                      seeds, self.max_iter, self.dof, pure=False)
+                                      seeds, self.max_iter, self.dof, self.measure, pure=False)
             futures.append((fut, sl))
         where = {f.key: sl for f, sl in futures}
         for k, fut in enumerate(as_completed([f for f, _ in futures], loop=self._client.loop), start=1):
@@ -241,15 +252,16 @@ class DaskEvaluator(Evaluator):
 
 def make_evaluator(problems: list[TrainingProblem], bounds_mode: str, max_iter: int,
                    workers: int | None = None, scheduler: str | None = None,
-                   dof: int = 2) -> Evaluator:
+                   dof: int = 2, measure: str = "iterations") -> Evaluator:
     """The engine the options ask for: Dask with ``scheduler``, else ``workers`` processes
-    (default: all cores; 1 means in-process). *dof*: the rulebook DOF being trained."""
+    (default: all cores; 1 means in-process). *dof*: the rulebook DOF being trained;
+    *measure*: what each run reports (``evaluate.measure_of`` the fitness)."""
     if scheduler:
-        return DaskEvaluator(problems, bounds_mode, max_iter, scheduler, dof)
+        return DaskEvaluator(problems, bounds_mode, max_iter, scheduler, dof, measure)
     if workers is None:
         workers = os.cpu_count() or 1
     if workers < 1:
         raise InputError("--workers", f"must be >= 1, got {workers}")
     if workers == 1:
-        return Evaluator(problems, bounds_mode, max_iter, dof)
-    return ProcessEvaluator(problems, bounds_mode, max_iter, workers, dof)
+        return Evaluator(problems, bounds_mode, max_iter, dof, measure)
+    return ProcessEvaluator(problems, bounds_mode, max_iter, workers, dof, measure)

@@ -101,6 +101,26 @@ def test_measured_training_runs_report_the_planners_own_iterations_and_work():
                 assert runs[p, k, r, 1] == res.work > 0
 
 
+def test_measured_work_is_the_same_when_threads_share_the_problems():
+    # Dask's threaded workers evaluate chunks of one population at once on the same problem
+    # objects; each run must still count only its own work.
+    from concurrent.futures import ThreadPoolExecutor
+
+    problems = [TrainingProblem.from_scenario(load_scenario(p)) for p in SCENARIOS]
+    rng = np.random.default_rng(9)
+    base = constant_outputs_genome((0.1, 0.6, 90.0, 30.0, 60.0, 40.0), "goal-frame")
+    genes = np.clip(base + 0.1 * rng.standard_normal((8, base.size)), 0, 1)
+    knots, consts = decode(genes, "goal-frame")
+    seeds = np.arange(6)
+    alone = iterations_for(problems, knots, consts, "goal-frame", seeds, 3000, measure="work")
+    with ThreadPoolExecutor(4) as pool:
+        parts = list(pool.map(
+            lambda i: iterations_for(problems, knots[i:i + 1], consts[i:i + 1], "goal-frame",
+                                     seeds, 3000, measure="work"), range(8)))
+    np.testing.assert_array_equal(np.concatenate(parts), alone)
+    assert all(int(pr.bundle.work[0]) == 0 for pr in problems)  # the shared counter untouched
+
+
 def test_the_work_baseline_is_the_tuned_rrts_median_work():
     scenarios = [load_scenario(p) for p in SCENARIOS]
     tuned = tuned_params("rrt")

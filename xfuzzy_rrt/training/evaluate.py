@@ -136,7 +136,9 @@ def iterations_for(problems: list[TrainingProblem], knots_b: np.ndarray, consts_
     out = np.empty(shape, dtype=np.int64)
     for s, pr in enumerate(problems):
         tree = make_tree(int(max_iter) + 2, pr.limits)
-        out[:, s] = population(pr, tree, knots_b, consts_b, mode, seeds, int(max_iter), measure)
+        # a plug-in's evaluation that only counts iterations keeps its 7-argument signature
+        extra = (measure,) if measure != "iterations" else ()
+        out[:, s] = population(pr, tree, knots_b, consts_b, mode, seeds, int(max_iter), *extra)
     return out
 
 
@@ -147,7 +149,10 @@ def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, s
     ``measure="work"``: int64[P, R, 2], iterations and work (:func:`run_population_measured`)."""
     buffers = make_trace(1, pr.dof, knots_b.shape[1], 1)
     if measure == "work":
-        return run_population_measured(pr.bundle, tree, knots_b, consts_b, mode, seeds,
+        # a work counter of this call's own: Dask runs chunks in threads that share the
+        # problem objects, and a shared counter would count the other thread's work too
+        bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))
+        return run_population_measured(bundle, tree, knots_b, consts_b, mode, seeds,
                                        int(max_iter), MIN_STEP_DEG, np.zeros(1, dtype=np.int64),
                                        buffers)
     return run_population(pr.bundle, tree, knots_b, consts_b, mode, seeds, int(max_iter),
@@ -306,11 +311,12 @@ def tuned_rrt_baseline(problems: list[TrainingProblem], seeds: np.ndarray,
         tree = make_tree(int(max_iter) + 2, pr.limits)
         meta0 = tree.meta.copy()
         stop = np.zeros(1, dtype=np.int64)
+        bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))  # a counter of its own
         work = []
         for seed in seeds:
             reset_tree(tree, meta0)
-            w0 = int(pr.bundle.work[0])
-            rrt_kernel(pr.bundle, tree, int(seed), int(max_iter), step, bias, stop)
-            work.append(int(pr.bundle.work[0]) - w0 + int(tree.meta[NN_VISITS]))
+            w0 = int(bundle.work[0])
+            rrt_kernel(bundle, tree, int(seed), int(max_iter), step, bias, stop)
+            work.append(int(bundle.work[0]) - w0 + int(tree.meta[NN_VISITS]))
         out[s] = float(np.median(work))
     return out

@@ -41,6 +41,25 @@ def shipped_rulebooks() -> list[Path]:
     return list(list_rulebooks())
 
 
+def two_joint_rulebooks() -> list[Path]:
+    """The shipped rulebooks ``fuzzy-rrt`` plans a 2-joint arm with (the golden scenarios are
+    2-joint problems; the N-DOF and any-arm rulebooks are pinned by their engine rows)."""
+    from xfuzzy_rrt.errors import InputError
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+    from xfuzzy_rrt.planners.fuzzy_rrt import check_rulebook_fits
+
+    two_joints = load_scenario(golden_scenarios()[0])
+    out = []
+    for p in shipped_rulebooks():
+        try:
+            check_rulebook_fits(load_rulebook(p), two_joints)
+        except InputError:
+            continue
+        out.append(p)
+    return out
+
+
 def engine_inputs(rb, n: int = 64) -> np.ndarray:
     """Fixed inputs spread over the rulebook's input ranges (plus the corners of the range)."""
     rng = np.random.default_rng(20261201)
@@ -76,7 +95,7 @@ def plans_frame() -> pd.DataFrame:
             print(f"note: {file} absent; its golden rows are not written", file=sys.stderr)
             continue
         sc = load_scenario(file)
-        planners = [("rrt", None)] + [("fuzzy-rrt", p) for p in shipped_rulebooks()]
+        planners = [("rrt", None)] + [("fuzzy-rrt", p) for p in two_joint_rulebooks()]
         for planner, rb in planners:
             for seed in SEEDS:
                 r = (plan_rrt(sc, seed=seed) if rb is None

@@ -180,7 +180,10 @@ def test_explain_finds_the_rulebook_that_made_a_default_any_arm_trace(tmp_path):
     s = one_arm(4)
     path = _write(s, tmp_path)
     out, trace = tmp_path / "r.json", tmp_path / "t.parquet"
-    code, _, err = run_main(["plan", path, "--seed", "0", "--max-iter", str(MAX_ITER),
+    # a seed whose plan takes several iterations (a lucky one connects at iteration 1)
+    seed = next(k for k in range(50)
+                if plan_scenario(s, "fuzzy-rrt", seed=k, max_iter=MAX_ITER).iterations >= 3)
+    code, _, err = run_main(["plan", path, "--seed", str(seed), "--max-iter", str(MAX_ITER),
                              "--out", out, "--trace", trace])
     assert code == 0, err
     frame = pd.read_parquet(trace)

@@ -38,7 +38,7 @@ def _scenario_file(name: str) -> Path | None:
 
 @pytest.mark.parametrize("name", sorted(ENGINE["rulebook"].unique()))
 def test_engine_outputs_of_shipped_rulebooks_match_golden_file(name):
-    rows = ENGINE[ENGINE["rulebook"] == name]
+    rows = ENGINE[ENGINE["rulebook"] == name].dropna(axis=1, how="all")  # rulebooks differ in outputs
     X = rows[[c for c in rows.columns if c.startswith("x")]].to_numpy()
     expected = rows[[c for c in rows.columns if c.startswith("y")]].to_numpy()
     got = evaluate(*load_rulebook(rulebooks_dir() / name).compiled, X)

@@ -98,7 +98,9 @@ class Semantics:
     #: ``planners/fuzzy_rrt.py:fuzzy_rrt_entry``), or ``None``.
     kernel: object = None
     #: The fitness evaluation of a population in training: ``fn(problem, tree, knots_b,
-    #: consts_b, mode, seeds, max_iter) -> int64[P, R]`` iterations (``-1``: failed).
+    #: consts_b, mode, seeds, max_iter) -> int64[P, R]`` iterations (``-1``: failed); one that
+    #: can also count work (``train --fitness work-cvar``) takes an eighth argument,
+    #: ``measure="work"``, and then returns int64[P, R, 2] (iterations, work).
     population: object = None
     #: One fuzzy evaluation per arm (the paper's workspace inputs are one arm's: its DOF is
     #: each arm's, and trace columns are prefixed ``arm<a>_``), else one for all arms (the
@@ -166,7 +168,7 @@ GOAL_FRAME = Semantics(
                       "clearance_deg": (0.0, 30.0), "reject_rate": (0.0, 1.0)}),
     output_ranges=_ro({"goal_bias": (0.0, 1.0), "uniform_share": (0.0, 1.0),
                        "ahead_deg": (0.0, 360.0), "behind_deg": (0.0, 360.0),
-                       "side_deg": (0.0, 180.0), "step_deg": (0.0, 30.0)}),
+                       "side_deg": (0.0, 180.0), "step_deg": (0.0, 120.0)}),
     units=_ro({"joint_dist_to_goal": "deg", "stagnation": "iterations", "clearance_deg": "deg",
                "reject_rate": "", "goal_bias": "", "uniform_share": "", "ahead_deg": "deg",
                "behind_deg": "deg", "side_deg": "deg", "step_deg": "deg"}),

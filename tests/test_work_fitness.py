@@ -144,3 +144,28 @@ def test_the_paper_semantics_evaluation_refuses_to_measure_work():
                            "absolute")
     with pytest.raises(ValueError, match="counts iterations only"):
         iterations_for(problems, knots, consts, "absolute", np.array([0]), 100, measure="work")
+
+
+def test_train_refuses_work_cvar_for_the_papers_semantics_before_computing_baselines(tmp_path):
+    from conftest import run_main
+
+    out = tmp_path / "rb"
+    proc = run_main("train", "--scenario", SCENARIOS[0], "--bounds", "absolute",
+                    "--fitness", "work-cvar", "--generations", "1", "--out", out)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and not out.exists()
+    assert lines == [lines[0]] and lines[0].startswith("error: --fitness: work-cvar counts")
+
+
+def test_work_cvar_without_the_tuned_file_is_one_line(monkeypatch, tmp_path):
+    from conftest import run_main
+    from xfuzzy_rrt.planners import tuned
+
+    monkeypatch.setattr(tuned, "tuned_dir", lambda: tmp_path)
+    out = tmp_path / "rb"
+    proc = run_main("train", "--scenario", SCENARIOS[0], "--bounds", "goal-frame",
+                    "--fitness", "work-cvar", "--generations", "1", "--out", out)
+    errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("error")]
+    assert proc.returncode == 2 and not out.exists(), proc.stderr
+    assert len(errors) == 1 and "work-cvar needs the tuned RRT" in errors[0]
+    assert "Traceback" not in proc.stderr

@@ -94,7 +94,7 @@ def train(
     import dataclasses
 
     from xfuzzy_rrt.errors import InputError
-    from xfuzzy_rrt.training.ga import GAConfig
+    from xfuzzy_rrt.training.ga import GAConfig, check_fitness_fits
     from xfuzzy_rrt.training.run import (
         TrainJob,
         load_training_scenarios,
@@ -121,6 +121,7 @@ def train(
     if target_fitness is None:
         target_fitness = 9750.0 if fitness == "paper" else 1e9
     base = v_base = ()
+    check_fitness_fits(fitness, bounds)  # before the baselines: a mismatch is one line at once
     if fitness in ("log-ratio", "work-cvar"):
         what = "RRT's median iterations" if fitness == "log-ratio" else "the tuned RRT's median work"
         typer.echo(f"computing {what} on {len(scenarios) + len(held_out)} "
@@ -167,8 +168,8 @@ def train(
                        "continue with the same command plus --resume")
         raise
     h = result.state.history
-    typer.echo(f"generations run: {len(h)}; final best fitness {h[-1]['best_fitness']:.1f}; "
-               f"chosen: {result.chosen_from}; validation fitness {result.validation_fitness:.1f}, "
+    typer.echo(f"generations run: {len(h)}; final best fitness {h[-1]['best_fitness']:.6g}; "
+               f"chosen: {result.chosen_from}; validation fitness {result.validation_fitness:.6g}, "
                f"median iterations {result.validation_iterations_median:g}, "
                f"success {100 * result.validation_success_rate:.0f} %")
     typer.echo(f"wrote {out}/ (rulebook), {out / 'history.csv'}, {out / 'checkpoint'}/")

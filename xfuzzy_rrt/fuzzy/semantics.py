@@ -99,9 +99,13 @@ class Semantics:
     kernel: object = None
     #: The fitness evaluation of a population in training: ``fn(problem, tree, knots_b,
     #: consts_b, mode, seeds, max_iter) -> int64[P, R]`` iterations (``-1``: failed); one that
-    #: can also count work (``train --fitness work-cvar``) takes an eighth argument,
+    #: also counts work (``"work"`` in :attr:`measures`) takes an eighth argument,
     #: ``measure="work"``, and then returns int64[P, R, 2] (iterations, work).
     population: object = None
+    #: What :attr:`population` can report per run: iterations always; ``"work"`` only when it
+    #: runs the planner's own kernel (a remembering evaluation does not spend the planner's
+    #: work), which ``train --fitness work-cvar`` needs.
+    measures: tuple[str, ...] = ("iterations",)
     #: One fuzzy evaluation per arm (the paper's workspace inputs are one arm's: its DOF is
     #: each arm's, and trace columns are prefixed ``arm<a>_``), else one for all arms (the
     #: DOF is the joints in all).
@@ -188,6 +192,7 @@ GOAL_FRAME = Semantics(
     modes=_ro({"goal-frame": 2}),  # planners/fuzzy_rrt.py's GOAL_FRAME
     kernel="xfuzzy_rrt.planners.fuzzy_rrt:goal_frame_entry",
     population="xfuzzy_rrt.training.evaluate:kernel_population",
+    measures=("iterations", "work"),
 )
 
 #: Joint-space lengths of ``goal-frame-any`` are Euclidean degrees divided by ``sqrt(N / 2)``

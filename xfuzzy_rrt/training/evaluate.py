@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
+from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.planners.fuzzy_rrt import GOAL_FRAME, MIN_STEP_DEG, fuzzy_rrt_kernel
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
@@ -127,6 +128,9 @@ def iterations_for(problems: list[TrainingProblem], knots_b: np.ndarray, consts_
     if measure not in MEASURES:
         raise ValueError(f"measure must be one of {', '.join(MEASURES)}, got {measure!r}")
     sem = _sem.of_mode(bounds_mode)
+    if measure not in sem.measures:
+        raise ValueError(f"the {sem.name} semantics' training evaluation counts "
+                         f"{' and '.join(sem.measures)} only, not {measure}")
     mode = sem.kernel_mode(bounds_mode)
     population = _sem.resolve(sem.population)
     knots_b = np.ascontiguousarray(knots_b, dtype=np.float64)
@@ -160,13 +164,10 @@ def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, s
 
 
 def memo_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, seeds,
-                    max_iter: int, measure: str = "iterations") -> np.ndarray:
+                    max_iter: int) -> np.ndarray:
     """A population's iterations through :func:`~.memo.paper_population` (the paper's
-    semantics: the planner's loop with its pure per-node work remembered). Remembered work is
-    not spent, so this evaluation counts no work: ``measure`` must be ``"iterations"``."""
-    if measure != "iterations":
-        raise ValueError("the paper semantics' training evaluation counts iterations only "
-                         "(its remembered per-node work is not the planner's work)")
+    semantics: the planner's loop with its pure per-node work remembered; remembered work is
+    not spent, so it measures iterations only)."""
     return paper_population(pr.bundle, tree, knots_b, consts_b, mode, seeds, int(max_iter),
                             MIN_STEP_DEG)
 
@@ -274,23 +275,36 @@ def score(runs: np.ndarray, kind: str, max_iter: int, baseline=None) -> np.ndarr
     return fitness(iterations_of(runs), max_iter)
 
 
+def rrt_runs(pr: TrainingProblem, seeds: np.ndarray, max_iter: int, step_deg: float,
+             goal_bias: float) -> np.ndarray:
+    """RRT's runs on one problem, one per seed: int64[R, 3] of (success, iterations, work),
+    the work counted as ``PlanResult.work`` counts it (failed runs included). What both
+    training baselines are medians of."""
+    from xfuzzy_rrt.planners.rrt import rrt_kernel
+
+    tree = make_tree(int(max_iter) + 2, pr.limits)
+    meta0 = tree.meta.copy()
+    stop = np.zeros(1, dtype=np.int64)
+    bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))  # a counter of its own
+    out = np.empty((len(seeds), 3), dtype=np.int64)
+    for r, seed in enumerate(seeds):
+        reset_tree(tree, meta0)
+        w0 = int(bundle.work[0])
+        ok, x, _ = rrt_kernel(bundle, tree, int(seed), int(max_iter), float(step_deg),
+                              float(goal_bias), stop)
+        out[r] = ok, x, int(bundle.work[0]) - w0 + int(tree.meta[NN_VISITS])
+    return out
+
+
 def rrt_baseline(problems: list[TrainingProblem], seeds: np.ndarray, max_iter: int) -> np.ndarray:
     """RRT's median iterations per problem over *seeds* (failures count as ``max_iter``):
     the reference the log-ratio fitness divides by, computed once per training run."""
-    from xfuzzy_rrt.planners.rrt import DEFAULT_GOAL_BIAS, DEFAULT_STEP_DEG, rrt_kernel
+    from xfuzzy_rrt.planners.rrt import DEFAULT_GOAL_BIAS, DEFAULT_STEP_DEG
 
     out = np.empty(len(problems))
     for s, pr in enumerate(problems):
-        tree = make_tree(int(max_iter) + 2, pr.limits)
-        meta0 = tree.meta.copy()
-        stop = np.zeros(1, dtype=np.int64)
-        its = []
-        for seed in seeds:
-            reset_tree(tree, meta0)
-            ok, x, _ = rrt_kernel(pr.bundle, tree, int(seed), int(max_iter), DEFAULT_STEP_DEG,
-                                  DEFAULT_GOAL_BIAS, stop)
-            its.append(x if ok else max_iter)
-        out[s] = float(np.median(its))
+        runs = rrt_runs(pr, seeds, max_iter, DEFAULT_STEP_DEG, DEFAULT_GOAL_BIAS)
+        out[s] = float(np.median(np.where(runs[:, 0] != 0, runs[:, 1], max_iter)))
     return out
 
 
@@ -299,24 +313,14 @@ def tuned_rrt_baseline(problems: list[TrainingProblem], seeds: np.ndarray,
     """The tuned RRT's (``rrt:tuned``, the shipped tuned file) median work per problem over
     *seeds*: the reference ``work-cvar`` divides by, computed once per training run. A failed
     run counts with the work it spent, as in the fair protocol."""
-    from xfuzzy_rrt.planners.rrt import rrt_kernel
-    from xfuzzy_rrt.planners.tuned import tuned_params
+    from xfuzzy_rrt.planners.tuned import tuned_params, tuned_path
 
     params = tuned_params("rrt")
-    if params is None:
-        raise ValueError("work-cvar needs the tuned RRT's parameters (data/tuned/rrt.toml)")
-    step, bias = float(params["step_deg"]), float(params["goal_bias"])
+    if params is None or not {"step_deg", "goal_bias"} <= set(params):
+        raise InputError("--fitness", f"work-cvar needs the tuned RRT's step_deg and goal_bias "
+                         f"in {tuned_path('rrt')} (make it with 'xfuzzy-rrt tune rrt --out FILE')")
     out = np.empty(len(problems))
     for s, pr in enumerate(problems):
-        tree = make_tree(int(max_iter) + 2, pr.limits)
-        meta0 = tree.meta.copy()
-        stop = np.zeros(1, dtype=np.int64)
-        bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))  # a counter of its own
-        work = []
-        for seed in seeds:
-            reset_tree(tree, meta0)
-            w0 = int(bundle.work[0])
-            rrt_kernel(bundle, tree, int(seed), int(max_iter), step, bias, stop)
-            work.append(int(bundle.work[0]) - w0 + int(tree.meta[NN_VISITS]))
-        out[s] = float(np.median(work))
+        runs = rrt_runs(pr, seeds, max_iter, params["step_deg"], params["goal_bias"])
+        out[s] = float(np.median(runs[:, 2]))
     return out

@@ -322,8 +322,7 @@ def run_training(job: TrainJob,
                  on_phase: Callable[[str], None] | None = None) -> TrainResult:
     """Train (or resume), checkpointing every generation; write the rulebook at the end."""
     from xfuzzy_rrt.training.checkpoint import load_checkpoint, save_checkpoint
-    from xfuzzy_rrt.training.evaluate import TrainingProblem
-    from xfuzzy_rrt.training.evaluate import measure_of
+    from xfuzzy_rrt.training.evaluate import TrainingProblem, measure_of
     from xfuzzy_rrt.training.workers import make_evaluator
 
     job.check_out()

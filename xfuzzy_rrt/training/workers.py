@@ -83,8 +83,9 @@ def _init_worker(problems: list[TrainingProblem], parent_pid: int) -> None:
                    "absolute", np.zeros(1, dtype=np.int64), 5)
 
 
-def _warm_in_worker(genes, bounds_mode, dof):
-    evaluate_chunk(genes, _PROBLEMS[:1], bounds_mode, np.zeros(1, dtype=np.int64), 5, dof)
+def _warm_in_worker(genes, bounds_mode, dof, measure="iterations"):
+    evaluate_chunk(genes, _PROBLEMS[:1], bounds_mode, np.zeros(1, dtype=np.int64), 5, dof,
+                   measure)
 
 
 def _evaluate_in_worker(genes, bounds_mode, seeds, max_iter, dof=2, measure="iterations"):
@@ -124,7 +125,7 @@ class Evaluator:
         before anything is timed. Why: generation 1's ``runs_per_s`` used to include the first
         compile and read "0 runs/s"."""
         evaluate_chunk(np.asarray(genes[:1]), self.problems[:1], self.bounds_mode,
-                       np.zeros(1, dtype=np.int64), 5, self.dof)
+                       np.zeros(1, dtype=np.int64), 5, self.dof, self.measure)
 
     def __call__(self, genes: np.ndarray, seeds: np.ndarray,
                  progress: Callable[[int, int], None] | None = None) -> np.ndarray:
@@ -174,7 +175,7 @@ class ProcessEvaluator(Evaluator):
         and load the kernels in it, so that no timed generation pays for either."""
         super().warm_up(genes)
         futures = [self._pool.submit(_warm_in_worker, np.asarray(genes[:1]), self.bounds_mode,
-                                     self.dof) for _ in range(self.workers)]
+                                     self.dof, self.measure) for _ in range(self.workers)]
         for fut in futures:
             fut.result()
 

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import xfuzzy_rrt.fuzzy.rulebook as rbmod
+import xfuzzy_rrt.fuzzy.watch as watchmod
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.planners import setup_memo
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
@@ -95,10 +96,12 @@ def test_a_plan_repeated_after_other_plans_is_identical(scenarios):
     assert np.array_equal(again.tree_parent, first.tree_parent)
 
 
-@pytest.fixture()
-def rulebook_copy(tmp_path, monkeypatch):
-    """A copy of the shipped default with old timestamps and no racy window (so the stat key
-    alone decides), and a counter of how often its bytes are hashed."""
+@pytest.fixture(params=["kernel-watch", "stamps-only"])
+def rulebook_copy(request, tmp_path, monkeypatch):
+    """A copy of the shipped default with old timestamps and no racy window, and a counter of
+    how often its bytes are hashed; once with kernel change notices (inotify, where this system
+    has them) and once with the stat key alone deciding."""
+    monkeypatch.setattr(watchmod, "ENABLED", request.param == "kernel-watch")
     root = tmp_path / "rb"
     shutil.copytree(rbmod.default_rulebook_path(), root)
     old = time.time_ns() - 3600 * 10**9
@@ -160,6 +163,8 @@ def test_a_file_added_to_the_rulebook_directory_is_seen(rulebook_copy):
 def test_a_freshly_written_rulebook_is_rehashed_until_its_stamps_can_be_trusted(
         tmp_path, monkeypatch):
     # an edit within the same timestamp tick as the last look-up cannot show in the stamps
+    # (without kernel notices: with them nothing is racy, tests/test_rulebook_watch.py)
+    monkeypatch.setattr(watchmod, "ENABLED", False)
     root = tmp_path / "rb"
     shutil.copytree(rbmod.default_rulebook_path(), root)
     hashed = []

@@ -56,6 +56,7 @@ import numpy as np
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.engine import infer
+from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_str, load_rulebook_cached
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.collision import direction_and_distance, nearest_obstacle_for_arm
 from xfuzzy_rrt.geometry.kinematics import arm_end_effector
@@ -296,8 +297,6 @@ _ENTRIES: dict[int, object] = {}
 
 def _resolve_rulebook(rulebook):
     """A loaded rulebook as given, else the (cached) directory or shipped default."""
-    from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_str, load_rulebook_cached
-
     if rulebook is None:
         rulebook = default_rulebook_str()
     elif hasattr(rulebook, "compiled"):

@@ -29,6 +29,8 @@ def check_seed(seed, count: int = 1, where: str = "--seed") -> int:
 
     Why one check for every command: without it a seed of 2^64 reached numba as an untyped
     integer (a TypingError traceback) and 10^23 overflowed a NumPy array."""
+    if type(seed) is int and count == 1 and 0 <= seed <= SEED_MAX:  # every plan call's case
+        return seed
     from xfuzzy_rrt.errors import InputError
 
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):

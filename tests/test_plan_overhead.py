@@ -331,3 +331,34 @@ def test_finishing_a_connect_run_joins_both_trees_as_numpy_would():
         assert not finish_connect_run(A, pa, na, B, pb, nb, la, lb, limits)[5]
     none = finish_connect_run(A, pa, na, B, pb, nb, -1, -1, limits)
     assert none[2].shape == (0, 3) and not none[4] and none[5]
+
+
+def test_set_ups_survive_a_cycle_of_many_problems_and_planners(scenarios, fresh_memo,
+                                                               monkeypatch):
+    # a benchmark's order: every problem x planner, then the next seed; 48 x 3 set-ups must
+    # all still be remembered when the cycle comes round (a memo of 128 missed every call)
+    problems = [dataclasses.replace(scenarios[i % len(scenarios)], name=f"p{i}")
+                for i in range(48)]
+    planners = ["fuzzy-rrt", "rrt", "rrt:tuned"]
+    for p in problems:
+        for planner in planners:
+            plan_scenario(p, planner, seed=0, max_iter=50)
+    misses = []
+    real = setup_memo.remember
+    monkeypatch.setattr(setup_memo, "remember", lambda *a: misses.append(a[0]) or real(*a))
+    for p in problems:
+        for planner in planners:
+            plan_scenario(p, planner, seed=1, max_iter=50)
+    assert misses == []
+
+
+def test_a_set_up_goes_with_its_scenario(scenarios, fresh_memo):
+    import gc
+
+    copy = dataclasses.replace(scenarios[0], name="short-lived")
+    plan_scenario(copy, "fuzzy-rrt", seed=0, max_iter=50)
+    plan_scenario(copy, "rrt", seed=0, max_iter=50)
+    assert len(setup_memo._memo) == 2
+    del copy
+    gc.collect()
+    assert len(setup_memo._memo) == 0

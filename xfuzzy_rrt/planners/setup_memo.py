@@ -18,7 +18,7 @@ When a remembered set-up is used:
 
 Errors are never remembered: only a set-up whose checks all passed is stored, so a call with
 bad inputs runs the checks and raises the same one-line error every time. The memo is bounded
-(:data:`MAX_ENTRIES`, oldest dropped first) and shared by threads; set-ups are immutable, and
+(:data:`MAX_ENTRIES`, oldest dropped first; an entry also goes when its scenario does) and shared by threads; set-ups are immutable, and
 what a call mutates (the tree, the work counter) is never part of one.
 """
 
@@ -28,8 +28,11 @@ import math
 import weakref
 from typing import Any, Callable, Hashable
 
-#: Set-ups kept (each a few small arrays and references to shared, immutable objects).
-MAX_ENTRIES = 128
+#: Set-ups kept (each a few small arrays and references to shared, immutable objects; an
+#: entry goes with its scenario). Why this many: the memo is used in a cycle (every problem x
+#: planner x setting, then the next seed), and a cycle one longer than the memo misses every
+#: time (128 made 48 problems x 3 planners re-check every call: +60 us each).
+MAX_ENTRIES = 4096
 _memo: dict[Hashable, tuple[Any, Any]] = {}
 
 
@@ -78,7 +81,7 @@ def lookup(key: Hashable, scenario: Any) -> Any | None:
 def remember(key: Hashable, scenario: Any, setup: Any) -> None:
     """Keep ``setup`` for ``key`` (nothing is kept for a scenario without weak references)."""
     try:
-        ref = weakref.ref(scenario)
+        ref = weakref.ref(scenario, lambda r, k=key: _forget(k, r))
     except TypeError:
         return
     _memo[key] = (ref, setup)
@@ -87,6 +90,13 @@ def remember(key: Hashable, scenario: Any, setup: Any) -> None:
             del _memo[next(iter(_memo))]
         except (KeyError, StopIteration, RuntimeError):  # another thread trimmed it first
             break
+
+
+def _forget(key: Hashable, ref: weakref.ref) -> None:
+    """The scenario of ``key``'s entry died: drop the entry if it is still that one's."""
+    hit = _memo.get(key)
+    if hit is not None and hit[0] is ref:
+        _memo.pop(key, None)
 
 
 def remembered(key: Hashable, scenario: Any, prepare: Callable[[], Any],

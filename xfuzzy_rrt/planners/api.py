@@ -10,6 +10,9 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners import registry as _registry
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
+from xfuzzy_rrt.planners.rng import check_seed
+from xfuzzy_rrt.planners.rrt import plan_rrt, plan_rrt_as
+from xfuzzy_rrt.planners.tuned import tuned_params, tuned_path
 
 #: The built-in exact planner names (every accepted label form is in planners/registry.py).
 PLANNERS = ("rrt", "fuzzy-rrt", "fuzzy-rrt-connect")
@@ -205,8 +208,6 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     Every planner goes through its registration's ``plan`` (:mod:`.registry`): one dict
     look-up, no chain of names.
     """
-    from xfuzzy_rrt.planners.rng import check_seed
-
     check_seed(seed)
     spec = parse_planner(planner, "--planner")
     entry = spec.planner
@@ -239,16 +240,16 @@ def parse_ompl_arg(label: str, arg: str, where: str) -> None:
 def plan_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter, step_deg,
                    goal_bias, trace, clearance_m, max_time_s) -> PlanResult:
     """``rrt`` with ``step_deg``/``goal_bias``; ``rrt:tuned`` with the tuned file's."""
-    from xfuzzy_rrt.planners.rrt import plan_rrt
-
     if spec.label == RRT_TUNED:  # the label fixes the settings: the tuned file's
         tuned = _tuned_rrt("--planner")
-        result = plan_rrt(scenario, seed=seed, max_iter=max_iter, clearance_m=clearance_m,
-                          max_time_s=max_time_s, **tuned)
-        return replace_result(result, planner=RRT_TUNED, planner_used=RRT_TUNED,
-                              params={**result.params, "tuned": True})
+        return plan_rrt_as(RRT_TUNED, _TUNED_PARAMS, scenario, seed=seed, max_iter=max_iter,
+                           clearance_m=clearance_m, max_time_s=max_time_s, **tuned)
     return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
                     goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
+
+
+#: What ``rrt:tuned`` adds to its result's ``params``.
+_TUNED_PARAMS = {"tuned": True}
 
 
 def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter,
@@ -294,8 +295,6 @@ def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, ma
 
 def _tuned_rrt(where: str) -> dict[str, float]:
     """``step_deg`` and ``goal_bias`` of the shipped ``rrt.toml``, or one InputError."""
-    from xfuzzy_rrt.planners.tuned import tuned_params, tuned_path
-
     tuned = tuned_params("rrt")
     if tuned is None or set(tuned) != {"step_deg", "goal_bias"}:
         raise InputError(where, f"{RRT_TUNED} needs the tuned file {tuned_path('rrt')} with "

@@ -176,6 +176,8 @@ def _warm_goal_frame_training_generator_and_engine() -> None:
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
     from xfuzzy_rrt.scenarios.generate import generate_one
 
+    # after the planner's kernels (same process, below): the goal-frame population runs the
+    # planner's own compiled kernels, loaded from the cache rather than compiled again
     _warm_training("goal-frame")
     generate_one(0, 0)
     evaluate(*load_rulebook(rulebooks_dir() / "expert").arrays(), np.zeros((1, 4)))
@@ -183,10 +185,10 @@ def _warm_goal_frame_training_generator_and_engine() -> None:
 
 #: Each run in its own process by :func:`_warm_numba_cache`, all at once.
 _WARM_GROUPS = {
-    "rrt-and-fuzzy-rrt": _warm_rrt_and_fuzzy_rrt,
+    "planners-then-goal-frame-training": lambda: (
+        _warm_rrt_and_fuzzy_rrt(), _warm_goal_frame_training_generator_and_engine()),
     "connect-and-certificate": _warm_connect_and_certificate,
     "paper-training": lambda: _warm_training("relative"),
-    "goal-frame-training": _warm_goal_frame_training_generator_and_engine,
 }
 
 

@@ -56,6 +56,12 @@ def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_ite
     n_seeds = seeds.shape[0]
     out = np.empty((n_ind, n_seeds, 2), dtype=np.int64)
     meta0 = T.meta.copy()
+    # Always False, but typed as a run-time bool (a literal ``False`` would be typed
+    # ``Literal[bool](False)``): with it, and the read-only rulebook arrays
+    # ``kernel_population`` passes, the kernels below are the very specialisations the
+    # planner compiles, so training and planning share one compiled (cached) kernel each
+    # instead of compiling two (about 100 s and 50 s each on a cold cache).
+    record = n_seeds < 0
     for p in range(n_ind):
         for r in range(n_seeds):
             reset_tree(T, meta0)
@@ -63,11 +69,11 @@ def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_ite
             if bounds_mode == GOAL_FRAME:
                 ok, iterations, _ = goal_frame_kernel(
                     P, T, seeds[r], max_iter, knots_b[p], consts_b[p], bounds_mode, min_step,
-                    stop, False, TR)
+                    stop, record, TR)
             else:
                 ok, iterations, _ = fuzzy_rrt_kernel(
                     P, T, seeds[r], max_iter, knots_b[p], consts_b[p], bounds_mode, min_step,
-                    stop, False, TR)
+                    stop, record, TR)
             out[p, r, 0] = iterations if ok else -1
             out[p, r, 1] = P.work[0] - work0 + T.meta[NN_VISITS]
     return out
@@ -146,12 +152,22 @@ def iterations_for(problems: list[TrainingProblem], knots_b: np.ndarray, consts_
     return out
 
 
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of *a* (the caller's array keeps its flags): numba types read-only
+    arrays apart, and a shipped rulebook's arrays are read-only, so a population passed this
+    way runs the planner's own compiled kernel rather than a second specialisation."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
 def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, seeds,
                       max_iter: int, measure: str = "iterations") -> np.ndarray:
     """A population's iterations through the planner's own kernel (:func:`run_population`):
     the ``population`` of a semantics with no faster evaluation (goal-frame). With
     ``measure="work"``: int64[P, R, 2], iterations and work (:func:`run_population_measured`)."""
     buffers = make_trace(1, pr.dof, knots_b.shape[1], 1)
+    knots_b, consts_b = _read_only(knots_b), _read_only(consts_b)
     if measure == "work":
         # a work counter of this call's own: Dask runs chunks in threads that share the
         # problem objects, and a shared counter would count the other thread's work too

@@ -176,17 +176,21 @@ def _warm_goal_frame_training_generator_and_engine() -> None:
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
     from xfuzzy_rrt.scenarios.generate import generate_one
 
-    # after the planner's kernels (same process, below): the goal-frame population runs the
-    # planner's own compiled kernels, loaded from the cache rather than compiled again
     _warm_training("goal-frame")
     generate_one(0, 0)
     evaluate(*load_rulebook(rulebooks_dir() / "expert").arrays(), np.zeros((1, 4)))
 
 
+def _warm_planners_then_goal_frame_training() -> None:
+    """One process: the goal-frame population runs the planners' own compiled kernels, so
+    it loads what the planners compiled instead of compiling the same kernels beside them."""
+    _warm_rrt_and_fuzzy_rrt()
+    _warm_goal_frame_training_generator_and_engine()
+
+
 #: Each run in its own process by :func:`_warm_numba_cache`, all at once.
 _WARM_GROUPS = {
-    "planners-then-goal-frame-training": lambda: (
-        _warm_rrt_and_fuzzy_rrt(), _warm_goal_frame_training_generator_and_engine()),
+    "planners-then-goal-frame-training": _warm_planners_then_goal_frame_training,
     "connect-and-certificate": _warm_connect_and_certificate,
     "paper-training": lambda: _warm_training("relative"),
 }

@@ -12,7 +12,8 @@ One generation, read top to bottom in :meth:`Trainer.step`:
    ``target_fitness`` (the paper's 9750).
 4. **Breed**: the ``elite`` best individuals pass unchanged; the rest are children of
    tournament selection, simulated binary crossover and polynomial mutation (pymoo's
-   operators, see the package docstring).
+   operators, written again number for number in :mod:`.operators`; see the package
+   docstring).
 5. **Checkpoint**: the bred population, the generator state and the history go to one file,
    written atomically, so that resuming after a crash continues exactly where it stopped.
 
@@ -46,6 +47,7 @@ import numpy as np
 from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.fuzzy.variables import N_RULES
 from xfuzzy_rrt.training.evaluate import FITNESSES, iterations_of, score
+from xfuzzy_rrt.training.operators import polynomial_mutation, sbx, tournament
 from xfuzzy_rrt.training.genome import (
     GENES_PER_FIS,
     MF_GENES,
@@ -288,55 +290,21 @@ def term_blocks(rng: np.random.Generator, sigma: float, n_fis: int) -> np.ndarra
 # ------------------------------------------------------------------------------ breeding
 
 
-class _Bounds:
-    """The minimal pymoo problem description its operators need (box [0, 1]^n)."""
-
-    def __init__(self, n: int):
-        from pymoo.core.problem import Problem
-
-        self._p = Problem(n_var=n, xl=np.zeros(n), xu=np.ones(n))
-
-    @property
-    def problem(self):
-        return self._p
-
-
-def _compare_max(pop, P, random_state=None, **kwargs):
-    """Tournament winner: the highest fitness; ties go to the lower population index."""
-    F = pop.get("F")[:, 0]  # pymoo minimises F; we store -fitness
-    S = np.empty(P.shape[0], dtype=int)
-    for i, row in enumerate(P):
-        best = row[0]
-        for j in row[1:]:
-            if F[j] < F[best] or (F[j] == F[best] and j < best):
-                best = j
-        S[i] = best
-    return S
-
-
 def breed(pop: np.ndarray, fit: np.ndarray, config: GAConfig, rng: np.random.Generator) -> np.ndarray:
-    """The next generation: elites unchanged, then selected, crossed and mutated children."""
-    from pymoo.core.population import Population
-    from pymoo.operators.crossover.sbx import SBX
-    from pymoo.operators.mutation.pm import PM
-    from pymoo.operators.selection.tournament import TournamentSelection
-
+    """The next generation: elites unchanged, then selected, crossed and mutated children
+    (:mod:`.operators`: pymoo's operators, number for number)."""
     n, n_var = pop.shape
-    problem = _Bounds(n_var).problem
     order = np.lexsort((np.arange(n), -fit))  # best first, stable
     elites = pop[order[: config.elite]]
     n_children = n - config.elite
     if n_children == 0:
         return elites.copy()
-    P = Population.new(X=pop, F=-fit[:, None])
-    selection = TournamentSelection(func_comp=_compare_max, pressure=config.tournament)
     n_matings = (n_children + 1) // 2
-    parents = selection.do(problem, P, n_matings, 2, to_pop=False, random_state=rng)
-    crossover = SBX(prob=config.crossover_prob, eta=config.crossover_eta, prob_var=0.5)
-    off = crossover.do(problem, P, parents, random_state=rng)
-    mutation = PM(prob=1.0, prob_var=config.mutation_rate, eta=config.mutation_eta)
-    off = mutation.do(problem, off, random_state=rng)
-    children = off.get("X")[:n_children].copy()
+    parents = tournament(fit, n_matings, config.tournament, rng)
+    off = sbx(pop[parents[:, 0]], pop[parents[:, 1]], config.crossover_prob,
+              config.crossover_eta, rng)
+    off = polynomial_mutation(off, config.mutation_rate, config.mutation_eta, rng)
+    children = off[:n_children].copy()
     if config.block_rate > 0:
         # term-block mutation (see term_blocks): one random FIS per chosen child
         hit = np.flatnonzero(rng.random(n_children) < config.block_rate)

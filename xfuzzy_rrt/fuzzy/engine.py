@@ -79,7 +79,7 @@ def _combine(c, r, a0, b0, a1, b1, a2, b2, a3, b3):
     return num / den
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def infer(knots, consts, x, out, fired_rule, fired_w, record):
     """Evaluate every FIS at input ``x`` (float64[4], inputs order) into ``out``
     float64[n_out] (``n_out = knots.shape[0]``; six at 2 DOF).
@@ -124,7 +124,7 @@ def infer(knots, consts, x, out, fired_rule, fired_w, record):
             fired_w[f, j] = 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def infer_batch(knots, consts, X):
     """Evaluate every row of ``X`` float64[n, 4]; return float64[n, n_fis] (single thread)."""
     n = X.shape[0]

@@ -137,7 +137,7 @@ class MinClearance:
     lower_bound_m: float
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _chain_speed_accel(links, qa_deg, qb_deg, first, last):
     """``(V, A)`` of the last link of the chain ``first .. last`` measured in the frame the
     chain hangs from (the world for an arm's own base, link ``first - 1`` for a self pair).
@@ -161,7 +161,7 @@ def _chain_speed_accel(links, qa_deg, qb_deg, first, last):
     return v, acc
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def element_speed_accel(P, qa_deg, qb_deg, vel, acc, off):
     """Per element (``signed.element_clearances`` order): ``vel`` bounds how fast its
     clearance changes per unit ``s`` on ``qa -> qb``, ``acc`` how fast the two closest points
@@ -201,7 +201,7 @@ def element_speed_accel(P, qa_deg, qb_deg, vel, acc, off):
                 e += 1
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def element_lower_bound(c0, c1, v, acc, off, width):
     """Nothing on an interval of ``width`` (in ``s``) whose ends have clearance ``c0, c1`` is
     below this, for one element with speed bound ``v``, acceleration bound ``acc`` and radius
@@ -233,7 +233,7 @@ def element_lower_bound(c0, c1, v, acc, off, width):
     return lb2 if lb2 > lb1 else lb1
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _interval_bound(c0, c1, vel, acc, off, width):
     """Nothing on the interval is below this: the smallest :func:`element_lower_bound`."""
     lb = np.inf
@@ -244,7 +244,7 @@ def _interval_bound(c0, c1, vel, acc, off, width):
     return lb
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def min_clearance_kernel(P, path, tol, max_evals, decide_contact):
     """``(value, segment, s, lower bound)`` of the signed clearance along ``path`` (degrees).
 

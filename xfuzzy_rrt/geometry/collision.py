@@ -125,7 +125,7 @@ def _point_box_dist(px, py, x0, y0, x1, y1):
     return math.sqrt(dx * dx + dy * dy)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def _segment_hits_box(ax, ay, bx, by, x0, y0, x1, y1):
     """Liang–Barsky: does the closed segment meet the closed rectangle?"""
     t0 = 0.0
@@ -202,7 +202,7 @@ def _obstacle_dist(ax, ay, bx, by, kind, o1, o2, o3, o4):
     return math.sqrt(d2)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def segment_obstacle_dist(ax, ay, bx, by, ob):
     """Exact distance from segment AB to obstacle row ``ob`` (0 when they meet)."""
     return _obstacle_dist(ax, ay, bx, by, ob[0], ob[1], ob[2], ob[3], ob[4])
@@ -262,7 +262,7 @@ def _orient(ax, ay, bx, by, cx, cy):
     return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def segment_segment_dist(ax, ay, bx, by, cx, cy, dx, dy):
     """Exact distance between the closed segments AB and CD in the plane (0 when they meet).
 
@@ -284,7 +284,7 @@ def segment_segment_dist(ax, ay, bx, by, cx, cy, dx, dy):
     return d
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def link_segments_into(P, q_deg, seg):
     """Every link of every arm as a segment ``seg[k] = (ax, ay, bx, by)`` (metres)."""
     for a in range(P.arm_first.shape[0] - 1):
@@ -301,7 +301,7 @@ def link_segments_into(P, q_deg, seg):
             y = ny
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def arm_arm_clearance(P, seg):
     """Smallest capsule-capsule distance between links of different arms (``inf``: one arm)."""
     best = np.inf
@@ -318,7 +318,7 @@ def arm_arm_clearance(P, seg):
     return best
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def has_self_pairs(P):
     """Does some arm have two non-adjacent links (three links or more)?"""
     for a in range(P.arm_first.shape[0] - 1):
@@ -327,7 +327,7 @@ def has_self_pairs(P):
     return False
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def self_clearance(P, seg):
     """Smallest capsule-capsule distance between non-adjacent links of one arm (``inf``: no arm
     has three links). Adjacent links share a joint and never count (module docstring)."""
@@ -365,7 +365,7 @@ def n_link_pairs(P):
     return n
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def clearance_kernel(P, q_deg):
     """Smallest distance between any link capsule and any obstacle, any other arm's capsule or
     a non-adjacent link of its own arm (<= 0: collision); ``inf`` with nothing to touch. Joint
@@ -402,7 +402,7 @@ def within_limits(limits_deg, q_deg):
     return True
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def config_free(P, q_deg, margin):
     """Within the joint limits and clearance strictly above ``margin``."""
     if not within_limits(P.limits, q_deg):
@@ -410,7 +410,7 @@ def config_free(P, q_deg, margin):
     return clearance_kernel(P, q_deg) > margin
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def link_motion_bound(links, qa_deg, qb_deg, k, first=0):
     """``M_k``: no point of link ``k`` moves faster than this per unit ``s`` on ``qa -> qb``.
 
@@ -430,7 +430,7 @@ def link_motion_bound(links, qa_deg, qb_deg, k, first=0):
     return mk
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def self_pair_motion_bound(links, qa_deg, qb_deg, k, m):
     """Lipschitz constant (m per unit ``s``) of the distance between links ``k < m`` of ONE arm
     (``m >= k + 2``) along ``qa -> qb``: ``link_motion_bound(links, qa, qb, m, first=k + 1)``.
@@ -539,7 +539,7 @@ def two_link_clearances(P, q0_deg, q1_deg):
     return c0, c1
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def edge_free_two_link(P, qa_deg, qb_deg, margin, ca0, ca1, cb0, cb1, probe=True):
     """:func:`edge_free` for ONE arm of two links (the only single-arm case without self
     pairs: every 2-DOF problem), given the per-link clearances at the ends when known.
@@ -696,7 +696,7 @@ def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has
     return True, cmin, ds
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def edge_free(P, qa_deg, qb_deg, margin):
     """Certified check of the straight joint segment ``qa -> qb`` (conservative advancement).
 
@@ -722,14 +722,14 @@ def edge_free(P, qa_deg, qb_deg, margin):
     return _edge_free(P, qa_deg, qb_deg, margin, True)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def edge_free_unprobed(P, qa_deg, qb_deg, margin):
     """:func:`edge_free` by conservative advancement alone, without probes: the reference its
     verdicts must equal (tests) and the baseline its work is measured against (benchmarks)."""
     return _edge_free(P, qa_deg, qb_deg, margin, False)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _edge_free(P, qa_deg, qb_deg, margin, probe):
     n_arms = P.arm_first.shape[0] - 1
     if n_arms == 1 and P.links.shape[0] == 2:  # one two-link arm: no arrays needed
@@ -786,7 +786,7 @@ def _edge_free(P, qa_deg, qb_deg, margin, probe):
             s = 1.0
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def nearest_obstacle_from_point(px, py, obstacles):
     """Distance (to the surface, 0 inside) and direction in [0, 2π) of the nearest obstacle.
 
@@ -825,7 +825,7 @@ def nearest_obstacle_from_point(px, py, obstacles):
     return best, angle, index
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def nearest_obstacle_for_arm(P, arm, q_deg, px, py):
     """:func:`nearest_obstacle_from_point` for a point of arm ``arm``, where the other arms'
     link capsules count as obstacles too (a second arm is an obstacle to the first).
@@ -863,7 +863,7 @@ def nearest_obstacle_for_arm(P, arm, q_deg, px, py):
     return best, angle, index
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def direction_and_distance(px, py, tx, ty):
     """Distance from P to T and the direction of T seen from P, wrapped to [0, 2π)."""
     vx = tx - px

@@ -24,7 +24,7 @@ def fk_step(x, y, theta, length, q_deg):
     return x + length * math.cos(theta), y + length * math.sin(theta), theta
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def joint_points_into(links, base, q_deg, out):
     """Write the base, every joint and the end effector (``[dof + 1, 2]``) into ``out``."""
     x = base[0]
@@ -38,7 +38,7 @@ def joint_points_into(links, base, q_deg, out):
         out[k + 1, 1] = y
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def end_effector(links, base, q_deg):
     """The tip of the last link as ``(x, y)``."""
     x = base[0]
@@ -58,7 +58,7 @@ def joint_points(links, base, q_deg) -> np.ndarray:
     return out
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def arm_end_effector(P, arm, q_deg):
     """The tip of arm ``arm`` of a :class:`~xfuzzy_rrt.geometry.problem.Problem`."""
     x = P.bases[arm, 0]

@@ -108,7 +108,7 @@ class PathCheck:
                 f"clearance {self.min_clearance_m * 1e6:.4g} um at q = ({q}) deg)")
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def certify_kernel(P, path, margin):
     """``(certified, first uncertified segment, first vertex outside the limits)``."""
     n = path.shape[0]

@@ -73,7 +73,7 @@ def single_arm_problem(links, base, radius, obstacles, limits, start=None, goal=
                    new_work_counter())
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def with_obstacles(P, obstacles):
     """``P`` with other obstacles (the robustness analysis moves and grows them per trial)."""
     return Problem(P.links, P.arm_first, P.bases, P.radii, obstacles, P.limits, P.start, P.goal,

@@ -29,7 +29,7 @@ from xfuzzy_rrt.geometry.collision import (
 )
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def signed_segment_obstacle_dist(ax, ay, bx, by, ob):
     """Exact signed distance from segment AB to obstacle row ``ob``; negative = depth inside."""
     if ob[0] == 0.0:  # circle: distance from the centre to the segment, minus the radius
@@ -62,7 +62,7 @@ def signed_segment_obstacle_dist(ax, ay, bx, by, ob):
     return -max(depth, 0.0)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def signed_segment_segment_dist(ax, ay, bx, by, cx, cy, dx, dy):
     """Exact signed distance between segments AB and CD; negative = penetration depth.
 
@@ -103,14 +103,14 @@ def signed_segment_segment_dist(ax, ay, bx, by, cx, cy, dx, dy):
     return -max(depth, 0.0)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def n_elements(P):
     """Links (each against the obstacles), pairs of links of different arms, and pairs of
     non-adjacent links of one arm."""
     return P.links.shape[0] + n_link_pairs(P)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def element_clearances(P, q_deg, out):
     """Signed clearance of every element (see the module docstring) into ``out``; the min.
 
@@ -162,7 +162,7 @@ def element_clearances(P, q_deg, out):
     return best
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def signed_clearance_kernel(P, q_deg):
     """Smallest signed clearance (negative: penetration depth), ``inf`` if nothing to hit."""
     out = np.empty(n_elements(P))

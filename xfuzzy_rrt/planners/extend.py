@@ -131,7 +131,7 @@ def _extend_two_link(P, T, near, step, q_near, q_new):
     return ACCEPTED, k
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def node_clearance(P, T, i):
     """``clearance_kernel(P, T.nodes[i])`` (same value, same work), keeping a two-link arm's
     per-link values in ``T.link_clear`` for the edges that will leave node ``i``."""

@@ -323,7 +323,7 @@ def pack_scenario(arrays, margin: float) -> np.ndarray:
     ]).astype(np.float64))
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _unpack(ptr):
     """The :func:`pack_scenario` buffer at ``ptr`` as the pieces of a problem bundle."""
     head = carray(ptr, (_HEADER,), dtype=np.float64)
@@ -349,14 +349,14 @@ def _unpack(ptr):
     return links, arm_first, bases, radii, obstacles, limits, head[3], head[4]
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _bundle_counting(ptr, counts, q):
     links, arm_first, bases, radii, obstacles, limits, margin, clear = _unpack(ptr)
     return Problem(links, arm_first, bases, radii, obstacles, limits, q, q, margin, clear,
                    counts[WORK:WORK + 1])
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _bundle_plain(ptr, counts, q):
     links, arm_first, bases, radii, obstacles, limits, margin, clear = _unpack(ptr)
     return Problem(links, arm_first, bases, radii, obstacles, limits, q, q, margin)
@@ -385,7 +385,7 @@ _AT3 = nb.types.boolean(nb.types.intp, nb.types.intp, nb.types.intp)
 _AT4 = nb.types.boolean(nb.types.intp, nb.types.intp, nb.types.intp, nb.types.intp)
 
 
-@nb.njit(_AT3, cache=True, nogil=True)
+@nb.njit(_AT3, cache=True, nogil=True, _nrt=True)
 def state_free_at(q_at, buffer_at, counts_at):
     """Compiled check of the configuration at address ``q_at`` in the :func:`pack_scenario`
     buffer at ``buffer_at`` (counters at ``counts_at``): the planners' own
@@ -405,7 +405,7 @@ def state_free_at(q_at, buffer_at, counts_at):
     return config_free(P, q, P.margin)
 
 
-@nb.njit(_AT4, cache=True, nogil=True)
+@nb.njit(_AT4, cache=True, nogil=True, _nrt=True)
 def motion_free_at(qa_at, qb_at, buffer_at, counts_at):
     """Compiled certified check of the straight motion from the configuration at ``qa_at`` to
     the one at ``qb_at``: :func:`~xfuzzy_rrt.geometry.collision.edge_free` on the whole

@@ -69,7 +69,7 @@ def path_cost_deg(path_deg: np.ndarray) -> float:
     return float(np.add.reduce(np.sqrt(np.add.reduce(d * d, axis=1)), axis=0))
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _block_sum(a, lo, n):
     """NumPy's pairwise summation of ``a[lo:lo + n]`` for ``n <= 128``: sequential below 8
     terms, else eight running sums combined as a balanced tree, then the remainder."""
@@ -100,7 +100,7 @@ def _block_sum(a, lo, n):
     return res
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _pairwise_sum(a, lo, n):
     """``np.add.reduce(a[lo:lo + n])`` bit for bit: NumPy halves a sum of more than 128 terms
     at a multiple of 8 and adds the halves' sums (left + right). The same tree, walked with an
@@ -141,7 +141,7 @@ def _pairwise_sum(a, lo, n):
             break
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def path_cost_compiled(path):
     """:func:`path_cost_deg` inside compiled code, the same float bit for bit (the same
     differences, squares and pairwise sums; ``tests/test_plan_overhead.py`` compares them)."""
@@ -158,7 +158,7 @@ def path_cost_compiled(path):
     return _pairwise_sum(seg, 0, k - 1)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def finish_tree_run(nodes, parent, n, last, limits):
     """What a result keeps of a tree planner's run, in one compiled call: copies of the first
     ``n`` nodes and parents, the path from the root to node ``last`` (none when ``last < 0``),
@@ -330,7 +330,7 @@ def replace_result(result: PlanResult, **changes: Any) -> PlanResult:
     return new
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def vertices_within(path, limits):
     """Every vertex of ``path`` [k, dof] finite and within ``limits`` [dof, 2] (one compiled
     pass instead of six NumPy calls: this runs after every plan)."""

@@ -49,7 +49,7 @@ def _rotl(x, k):
     return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def seed_state(seed, state):
     """Fill ``state`` (uint64[4]) from an integer seed via SplitMix64."""
     z = np.uint64(seed & 0xFFFFFFFFFFFFFFFF)
@@ -61,7 +61,7 @@ def seed_state(seed, state):
         state[i] = x ^ (x >> np.uint64(31))
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def next_u64(state):
     """Advance the generator; return the next 64-bit output."""
     s0 = state[0]
@@ -83,7 +83,7 @@ def next_u64(state):
     return result
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def uniform(state):
     """A double in [0, 1) with 53 random bits."""
     return np.float64(next_u64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)

@@ -45,7 +45,7 @@ DEFAULT_ATTEMPTS = 200
 _MIN_GAIN_DEG = 1e-9
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _seg_len(path, i):
     s = 0.0
     for d in range(path.shape[1]):
@@ -54,7 +54,7 @@ def _seg_len(path, i):
     return math.sqrt(s)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _locate(cum, n, t):
     """Index ``i`` of the segment ``[cum[i], cum[i + 1]]`` holding arc length ``t``."""
     i = 0
@@ -63,7 +63,7 @@ def _locate(cum, n, t):
     return i
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _point_on(path, cum, i, t, out):
     """Write the point at arc length ``t`` on segment ``i`` into ``out``."""
     seg = cum[i + 1] - cum[i]
@@ -80,7 +80,7 @@ def _point_on(path, cum, i, t, out):
         out[:] = path[i + 1]
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _same(a, b):
     for d in range(a.shape[0]):
         if a[d] != b[d]:
@@ -88,7 +88,7 @@ def _same(a, b):
     return True
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _dist(a, b):
     s = 0.0
     for d in range(a.shape[0]):
@@ -96,7 +96,7 @@ def _dist(a, b):
     return math.sqrt(s)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def shortcut_kernel(P, path, seed, attempts, margin):
     """Return ``(buffer, n)``: the shortened path is ``buffer[:n]`` (see module docstring)."""
     dof = path.shape[1]

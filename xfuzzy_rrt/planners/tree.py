@@ -141,7 +141,7 @@ def _cell_of(grid, meta, x, y):
     return cx, cy
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def _grid_add(cell_next, cell_head, meta, grid, i, x, y):
     """File node ``i`` at (x, y) in its grid cell."""
     cx, cy = _cell_of(grid, meta, x, y)
@@ -172,7 +172,7 @@ def _scan_cell(nodes, cell_next, cell_head, c, q, best_d2, best_i, visits):
     return best_d2, best_i, visits
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def _grid_nearest(nodes, cell_next, cell_head, meta, grid, q):
     """Index of the node nearest to ``q`` (Euclidean over every joint, degrees; lowest index on
     ties). Cells are over the first two joints; a ring's distance in those two joints is a
@@ -223,7 +223,7 @@ def _grid_nearest(nodes, cell_next, cell_head, meta, grid, q):
     return best_i
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def _grid_nearest_occ(nodes, cell_next, cell_head, meta, grid, occ, q):
     """:func:`_grid_nearest` reading the occupied-cell bits ``occ`` (``T.occ``): the same rings,
     the same cells and nodes visited (so the same answer and ``NN_VISITS``), but an empty cell
@@ -297,7 +297,7 @@ def _d2(nodes, i, q):
     return d2
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def _select(nodes, perm, lo, hi, k, axis):
     """Reorder ``perm[lo:hi]`` so that position ``k`` holds the node of rank ``k - lo`` along
     ``axis``, smaller-or-equal ones before it and greater-or-equal ones after (quickselect,
@@ -325,7 +325,7 @@ def _select(nodes, perm, lo, hi, k, axis):
             return
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def _kd_build(T, n):
     """Balanced k-d tree over nodes ``0 .. n-1``: median splits along the range's widest axis,
     down to buckets of at most ``KD_LEAF`` nodes."""
@@ -375,7 +375,7 @@ def _kd_build(T, n):
     T.meta[KD_N] = n
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def _kd_nearest(T, q):
     """Exact nearest node: k-d tree search, then the buffer (lowest index on ties).
 
@@ -492,7 +492,7 @@ def _brute_max(dof):
     return BRUTE_MAX_KD[min(dof, 7) - 3]
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def _scan_nodes(nodes, meta, q):
     """Linear scan of every node (lowest index on ties: only a strictly smaller distance
     replaces the best); the arrays, not the tree (see :func:`_grid_nearest_occ`)."""
@@ -522,7 +522,7 @@ def nearest(T, q):
     return _kd_nearest(T, q)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def reset_tree(T, meta0):
     """Empty ``T`` for the next run (``meta0``: its ``meta`` when new); no allocation."""
     T.meta[:] = meta0
@@ -530,7 +530,7 @@ def reset_tree(T, meta0):
     T.occ[:] = 0
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def nearest_brute(nodes, n, q):
     """Linear scan; the reference the grid and k-d searches are tested against."""
     best_d2 = np.inf
@@ -543,7 +543,7 @@ def nearest_brute(nodes, n, q):
     return best_i
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def extract_path(nodes, parent, last):
     """Configurations from the root to node ``last`` (``[k, dof]``)."""
     k = 0

@@ -121,7 +121,7 @@ def perturb_paths(path: np.ndarray, n: int, p: Perturbation,
     return path[None, :, :] + draw(rng, (n,) + path.shape, p.sigma_joint_deg, p.distribution)
 
 
-@nb.njit(cache=True, nogil=True, parallel=True)
+@nb.njit(cache=True, nogil=True, parallel=True, _nrt=True)
 def trials_kernel(P, obstacles_t, paths_t, tol, max_evals, value, lower, hit):
     """Per trial: exact min signed clearance, its lower bound, and the obstacle it is to."""
     n = obstacles_t.shape[0]

@@ -215,7 +215,7 @@ def _draw_trap(rng: np.random.Generator, name: str) -> Scenario:
                     obstacles=tuple(obstacles))
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def _free_grid(P, angles, margin):
     free = np.empty((angles.size, angles.size), dtype=np.bool_)
     q = np.empty(2)

@@ -36,7 +36,7 @@ from xfuzzy_rrt.training.memo import paper_population
 FAILURE_REWARD = -100.0
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_step,
                             stop, TR):
     """Iterations and work of every (individual, seed) run: int64[P, R, 2].
@@ -79,7 +79,7 @@ def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_ite
     return out
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def run_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_step, stop, TR):
     """Iterations of every (individual, seed) run: int64[P, R], ``-1`` for a failed run
     (:func:`run_population_measured` without the work column)."""

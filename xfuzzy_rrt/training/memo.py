@@ -45,9 +45,10 @@ from xfuzzy_rrt.planners.tree import _d2, add_node, nearest, reset_tree
 _BIAS, _STEP, _BOX = 0, 1, 2
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=False)
 def paper_run(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, memo, seen,
-              goal_step, goal_outcome, stamp):
+              goal_step, goal_outcome, stamp, state, x, y, dummy_rule, dummy_w, sample, q_near,
+              q_new, goal_ws):
     """``(success, iterations)`` of one Fuzzy-RRT run, as
     :func:`~xfuzzy_rrt.planners.fuzzy_rrt.fuzzy_rrt_kernel` gives them.
 
@@ -55,21 +56,14 @@ def paper_run(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, memo, 
     ``goal_outcome`` [capacity] are scratch buffers reused across runs: an entry belongs to
     this run only where ``seen`` (for the outputs) or ``goal_outcome`` (for goal extensions,
     stored as ``stamp * 8 + outcome``) carries this run's ``stamp`` (unique per run of one set
-    of buffers), so nothing is cleared between runs.
+    of buffers), so nothing is cleared between runs. ``state`` ... ``goal_ws`` are the loop's
+    scratch buffers, allocated once per population by :func:`paper_population`: the loop is
+    compiled without reference counting (``_nrt=False``) and may not allocate.
     """
-    state = np.empty(4, dtype=np.uint64)
     seed_state(seed, state)
     n_arms = P.arm_first.shape[0] - 1
     n_out = knots.shape[0]
     dof = P.start.shape[0]
-    x = np.empty(4, dtype=np.float64)
-    y = np.empty(n_out, dtype=np.float64)
-    dummy_rule = np.empty((n_out, MAX_FIRED), dtype=np.int32)
-    dummy_w = np.empty((n_out, MAX_FIRED), dtype=np.float64)
-    sample = np.empty(dof, dtype=np.float64)
-    q_near = np.empty(dof, dtype=np.float64)
-    q_new = np.empty(dof, dtype=np.float64)
-    goal_ws = np.empty((n_arms, 2), dtype=np.float64)
     for a in range(n_arms):
         goal_ws[a, 0], goal_ws[a, 1] = arm_end_effector(P, a, P.goal)
     no_obstacle_dist = knots[0, 3, 4]
@@ -141,7 +135,7 @@ def paper_run(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, memo, 
     return False, max_iter
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, _nrt=True)
 def paper_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_step):
     """Iterations int64[n, R] (``-1`` = failed) of every (individual, seed) run of the paper's
     semantics (absolute or relative bounds): one compiled call for a whole chunk.
@@ -159,12 +153,24 @@ def paper_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_
     goal_step = np.empty(cap, dtype=np.float64)
     goal_outcome = np.zeros(cap, dtype=np.int64)
     stamp = 0
+    n_out = knots_b.shape[1]
+    dof = T.nodes.shape[1]
+    state = np.empty(4, dtype=np.uint64)
+    x = np.empty(4, dtype=np.float64)
+    y = np.empty(n_out, dtype=np.float64)
+    dummy_rule = np.empty((n_out, MAX_FIRED), dtype=np.int32)
+    dummy_w = np.empty((n_out, MAX_FIRED), dtype=np.float64)
+    sample = np.empty(dof, dtype=np.float64)
+    q_near = np.empty(dof, dtype=np.float64)
+    q_new = np.empty(dof, dtype=np.float64)
+    goal_ws = np.empty((P.arm_first.shape[0] - 1, 2), dtype=np.float64)
     for p in range(n_ind):
         for r in range(n_seeds):
             reset_tree(T, meta0)
             stamp += 1
             ok, iterations = paper_run(P, T, seeds[r], max_iter, knots_b[p], consts_b[p],
                                        bounds_mode, min_step, memo, seen, goal_step,
-                                       goal_outcome, stamp)
+                                       goal_outcome, stamp, state, x, y, dummy_rule, dummy_w,
+                                       sample, q_near, q_new, goal_ws)
             out[p, r] = iterations if ok else -1
     return out

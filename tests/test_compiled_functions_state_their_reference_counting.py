@@ -2,11 +2,12 @@
 
 Why: the planner and training loops and the geometry and tree helpers they call are compiled
 without numba's reference counting (``_nrt=False``), which made 2-joint RRT and the training
-loop 1.7-1.8x faster (its atomic increments and decrements were a third of their time). numba gives a function
-that does not state the flag the flag of whichever compilation first reaches it: a helper that
-allocates would then compile when a counted caller reached it first and fail ("NRT required")
-when an uncounted loop did, depending on the order of first calls and on what numba's cache
-held. Stating the flag everywhere makes each function's compilation the same whoever calls it.
+loop 1.7-1.8x faster (its atomic increments and decrements were a third of their time). numba
+gives a function that does not state the flag the flag of whichever compilation first reaches
+it: a helper that allocates would then compile when a counted caller reached it first and fail
+("NRT required") when an uncounted loop did, depending on the order of first calls and on what
+numba's cache held. Stating the flag everywhere makes each function's compilation the same
+whoever calls it.
 Functions inlined at numba's IR level (``inline="always"``) take their caller's flag and are
 exempt.
 """

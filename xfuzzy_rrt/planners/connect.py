@@ -147,16 +147,14 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step
     """
     n_out = knots.shape[0]
     dof = P.start.shape[0]
-    # The loop is compiled without numba's reference counting (``_nrt=False``): it allocates
-    # nothing and only borrows these buffers, and the atomic increments and decrements of
-    # every array it touched were a third of its time (perf, 2026-12-04).
+    # an uncounted loop (README, "No reference counting in the loops") borrows these buffers
     return _connect_loop(
         P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record, TR, grown,
         connect_nodes, counts, np.empty(4, dtype=np.uint64), np.empty(4, dtype=np.float64),
         np.empty(n_out, dtype=np.float64), np.empty(n_out, dtype=np.float64),
         np.empty((n_out, MAX_FIRED), dtype=np.int32),
         np.empty((n_out, MAX_FIRED), dtype=np.float64), np.empty(2 * dof, dtype=np.float64),
-        np.empty((8, dof), dtype=np.float64), np.zeros(2, dtype=np.int64),
+        np.empty((7, dof), dtype=np.float64), np.zeros(2, dtype=np.int64),
         np.zeros(2, dtype=np.float64))
 
 

@@ -182,9 +182,7 @@ def fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode, min_step,
     n_arms = P.arm_first.shape[0] - 1
     n_out = knots.shape[0]
     dof = P.start.shape[0]
-    # The loop is compiled without numba's reference counting (``_nrt=False``): it allocates
-    # nothing and only borrows these buffers, and the atomic increments and decrements of
-    # every array it touched were a third of its time (perf, 2026-12-04).
+    # an uncounted loop (README, "No reference counting in the loops") borrows these buffers
     return _fuzzy_rrt_loop(
         P, T, seed, max_iter, knots, consts, bounds_mode, min_step, stop, record, TR,
         np.empty(4, dtype=np.uint64), np.empty(4 * n_arms, dtype=np.float64),

@@ -176,9 +176,7 @@ def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step
     """
     n_out = knots.shape[0]
     dof = P.start.shape[0]
-    # The loop is compiled without numba's reference counting (``_nrt=False``): it allocates
-    # nothing and only borrows these buffers, and the atomic increments and decrements of
-    # every array it touched were a third of its time (perf, 2026-12-04).
+    # an uncounted loop (README, "No reference counting in the loops") borrows these buffers
     return _goal_frame_loop(
         P, T, seed, max_iter, knots, consts, min_step, stop, record, TR,
         np.empty(4, dtype=np.uint64), np.empty(4, dtype=np.float64),

@@ -40,9 +40,7 @@ def rrt_kernel(P, T, seed, max_iter, step, goal_bias, stop):
     """Run RRT on problem ``P`` growing tree ``T``; return ``(success, iterations, index of the
     last path node or -1)``. ``stop[0] != 0`` (a wall-clock budget ran out) ends the run."""
     dof = P.start.shape[0]
-    # The loop is compiled without numba's reference counting (``_nrt=False``): it allocates
-    # nothing and only borrows these buffers, and the atomic increments and decrements of
-    # every array it touched were a third of its time (perf, 2026-12-04).
+    # an uncounted loop (README, "No reference counting in the loops") borrows these buffers
     return _rrt_loop(P, T, seed, max_iter, step, goal_bias, stop,
                      np.empty(4, dtype=np.uint64), np.empty(dof, dtype=np.float64),
                      np.empty(dof, dtype=np.float64), np.empty(dof, dtype=np.float64))

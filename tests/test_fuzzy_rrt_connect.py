@@ -274,3 +274,28 @@ def test_a_dof_free_rulebook_round_trips_through_fll(tmp_path):
     back = import_fll(tmp_path / "fll")
     assert back.semantics is rb.semantics and back.semantics.dof_free
     assert all((a == b).all() for a, b in zip(back.arrays(), rb.arrays()))
+
+
+@pytest.mark.parametrize("s", [single_arm(4, 0), dual_arm(3, 0)], ids=lambda s: s.name)
+def test_the_clearance_input_is_the_clearance_of_the_node_it_was_read_at(s):
+    # the loop reads each node's clearance as it was measured when the node was accepted (the
+    # roots once per run) instead of measuring it again: every traced value must still equal
+    # an independent measurement at that row's node, in either tree
+    import math
+
+    from xfuzzy_rrt.geometry.collision import clearance
+    from xfuzzy_rrt.planners.goal_frame import problem_lever
+
+    arrays = s.arrays()
+    lever = problem_lever(arrays.problem(1e-6))
+    rows_per_tree = [0, 0]
+    for seed in range(12):
+        r = plan_fuzzy_rrt_connect(s, seed=seed, trace=True, max_iter=20_000)
+        t = r.trace
+        scale = r.params["length_scale"]
+        for _, row in t.iterrows():
+            rows_per_tree[int(row["tree"])] += 1
+            q = r.tree_nodes_deg[int(row["from_node"])]
+            want = max(clearance(arrays, q), 0.0) * math.degrees(1.0) / lever / scale
+            assert row["norm_clearance"] == pytest.approx(want, rel=1e-12, abs=1e-12)
+    assert min(rows_per_tree) >= 3, rows_per_tree  # both trees' nodes were read

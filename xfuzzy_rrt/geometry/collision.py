@@ -371,6 +371,13 @@ def clearance_kernel(P, q_deg):
     a non-adjacent link of its own arm (<= 0: collision); ``inf`` with nothing to touch. Joint
     limits are not considered.
     """
+    return clearance_into(P, q_deg, np.empty((P.links.shape[0], 4)))
+
+
+@nb.njit(cache=True, nogil=True, _nrt=False)
+def clearance_into(P, q_deg, seg):
+    """:func:`clearance_kernel` with the link-segment buffer ``seg`` ``[L, 4]`` given: what the
+    planners' loops call with their tree's buffer (:func:`edge_free_into`), allocating nothing."""
     best = np.inf
     n_arms = P.arm_first.shape[0] - 1
     for a in range(n_arms):
@@ -384,7 +391,6 @@ def clearance_kernel(P, q_deg):
             y = ny
     has_self = has_self_pairs(P)
     if n_arms > 1 or has_self:
-        seg = np.empty((P.links.shape[0], 4))
         link_segments_into(P, q_deg, seg)
         if n_arms > 1:
             best = min(best, arm_arm_clearance(P, seg))
@@ -731,6 +737,24 @@ def edge_free_unprobed(P, qa_deg, qb_deg, margin):
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def _edge_free(P, qa_deg, qb_deg, margin, probe):
+    n = P.links.shape[0]
+    if n == 2 and P.arm_first.shape[0] == 2:  # one two-link arm: no buffers needed
+        nan = np.nan
+        return edge_free_two_link(P, qa_deg, qb_deg, margin, nan, nan, nan, nan, probe)[0]
+    return _edge_free_into(P, qa_deg, qb_deg, margin, probe, np.empty((n, 4)), np.empty(n),
+                           np.empty((n, n)))
+
+
+@nb.njit(cache=True, nogil=True, _nrt=False)
+def edge_free_into(P, qa_deg, qb_deg, margin, seg, mks, msf):
+    """:func:`edge_free` with its buffers given (``seg`` ``[L, 4]``, ``mks`` ``[L]``, ``msf``
+    ``[L, L]``, ``L`` links in all; a tree's ``seg``/``mks``/``msf``): the planners' loops call
+    it once per extension and allocate nothing. Same verdict, same work."""
+    return _edge_free_into(P, qa_deg, qb_deg, margin, True, seg, mks, msf)
+
+
+@nb.njit(cache=True, nogil=True, _nrt=False)
+def _edge_free_into(P, qa_deg, qb_deg, margin, probe, seg, mks, msf):
     n_arms = P.arm_first.shape[0] - 1
     if n_arms == 1 and P.links.shape[0] == 2:  # one two-link arm: no arrays needed
         nan = np.nan
@@ -743,17 +767,13 @@ def _edge_free(P, qa_deg, qb_deg, margin, probe):
     clear = P.clearance
     if margin < clear:
         return False
-    n_links = P.links.shape[0]
     need_seg = n_arms > 1 or has_self
-    seg = np.empty((n_links if need_seg else 0, 4))
     # The motion bounds depend only on the segment: computed once, not at every stop.
-    mks = np.empty(n_links)
     for a in range(n_arms):
         first = P.arm_first[a]
         for k in range(first, P.arm_first[a + 1]):
             mks[k] = link_motion_bound(P.links, qa_deg, qb_deg, k, first)
     # Self pairs (k, m >= k + 2 of one arm): their relative motion bound, in msf[k, m].
-    msf = np.empty((n_links if has_self else 0, n_links if has_self else 0))
     if has_self:
         for a in range(n_arms):
             for k in range(P.arm_first[a], P.arm_first[a + 1]):

@@ -16,7 +16,8 @@ iteration: iteration 1 grows the start tree, iteration 2 the goal tree, ...):
    node nearest to that tree's previous sample, its root at first -- the paper's carried
    ``nearest_node``, one per tree): ``joint_dist_to_goal`` = ``|target - q|``;
    ``stagnation`` = iterations (of both trees) since the gap between the two trees' newest
-   nodes last shrank; ``clearance_deg`` at ``q``; ``reject_rate`` of the growing tree's own
+   nodes last shrank; ``clearance_deg`` at ``q`` (as measured when ``q`` was accepted, the
+   roots' once per run: not measured again); ``reject_rate`` of the growing tree's own
    extensions (each tree explores its own region, so each has its own clutter estimate).
 3. **Sample** exactly as goal-frame Fuzzy-RRT
    (:func:`~xfuzzy_rrt.planners.goal_frame.sample_goal_frame`) with the target in the goal's
@@ -74,10 +75,9 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.semantics import length_scale
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
-from xfuzzy_rrt.geometry.collision import clearance_kernel
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
-from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.extend import extend, node_clearance
 from xfuzzy_rrt.planners.goal_frame import (
     REJECT_DECAY,
     _joint_dist,
@@ -183,6 +183,9 @@ def _connect_loop(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step,
 
     add_node(TA, P.start, -1)
     add_node(TB, P.goal, -1)
+    if has_obstacles:  # the roots' clearance, once; every other node keeps the one it was
+        TA.clear[0] = node_clearance(P, TA, 0)  # accepted with (extend)
+        TB.clear[0] = node_clearance(PR, TB, 0)
     best = _joint_dist(P.start, P.goal)
     stagnation = 0.0
     g = START_TREE
@@ -213,7 +216,7 @@ def _connect_loop(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step,
         q = G.nodes[from_node]
         d_target = _joint_dist(q, target)
         if has_obstacles:
-            c = clearance_kernel(P, q)
+            c = G.clear[from_node]
             c_in = max(c, 0.0) * deg_per_m / scale
         else:
             c_in = clear_top

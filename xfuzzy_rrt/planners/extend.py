@@ -15,8 +15,8 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.geometry.collision import (
-    clearance_kernel,
-    edge_free,
+    clearance_into,
+    edge_free_into,
     edge_free_two_link,
     n_distance_pairs,
     two_link_clearances,
@@ -64,10 +64,10 @@ def extend(P, T, near, sample, step, q_near, q_new):
         return NODE_IN_COLLISION, -1
     if dof == 2 and P.arm_first.shape[0] == 2:
         return _extend_two_link(P, T, near, step, q_near, q_new)
-    c_new = clearance_kernel(P, q_new)
+    c_new = clearance_into(P, q_new, T.seg)
     if not c_new > P.margin:
         return NODE_IN_COLLISION, -1
-    if not edge_free(P, q_near, q_new, P.margin):
+    if not edge_free_into(P, q_near, q_new, P.margin, T.seg, T.mks, T.msf):
         return EDGE_BLOCKED, -1
     k = add_node(T, q_new, near)
     T.clear[k] = c_new
@@ -80,7 +80,8 @@ def extend(P, T, near, sample, step, q_near, q_new):
         g2 += gj * gj
     if at_goal:
         return GOAL_REACHED, k
-    if math.sqrt(g2) <= step and edge_free(P, q_new, P.goal, P.margin):
+    if math.sqrt(g2) <= step and edge_free_into(P, q_new, P.goal, P.margin, T.seg, T.mks,
+                                                 T.msf):
         g = add_node(T, P.goal, k)
         T.clear[g] = np.nan
         return GOAL_REACHED, g
@@ -142,4 +143,4 @@ def node_clearance(P, T, i):
         T.link_clear[i, 0] = c0
         T.link_clear[i, 1] = c1
         return min(min(np.inf, c0), c1)
-    return clearance_kernel(P, q)
+    return clearance_into(P, q, T.seg)

@@ -79,6 +79,13 @@ class TreeArrays(NamedTuple):
     #: ``occ[ncy + x]`` (bit ``y``), so that a ring search skips empty cells without reading
     #: them (:func:`_grid_nearest_occ`); zeroed with ``cell_head``
     occ: np.ndarray
+    #: scratch of the certified checks of any other arm (:func:`~xfuzzy_rrt.geometry.collision.
+    #: edge_free_into`, ``clearance_into``; ``L`` joints in all): link segments ``[L, 4]``,
+    #: motion bounds ``[L]`` and self-pair bounds ``[L, L]``. Here, not in the shared problem
+    #: record, because a tree belongs to one run at a time and Dask threads share problems.
+    seg: np.ndarray
+    mks: np.ndarray
+    msf: np.ndarray
 
 
 #: ``meta`` slot holding how many nodes the k-d tree covers (the rest are in the buffer).
@@ -122,7 +129,9 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
         np.zeros((KD_STACK + 1 if dof > 2 else 1, dof), dtype=np.float64),
         np.empty(capacity, dtype=np.float64),
         np.full((capacity + 1 if dof == 2 else 1, 2), np.nan, dtype=np.float64),
-        np.zeros(ncy + ncx if dof == 2 and ncx <= 64 and ncy <= 64 else 1, dtype=np.uint64))
+        np.zeros(ncy + ncx if dof == 2 and ncx <= 64 and ncy <= 64 else 1, dtype=np.uint64),
+        np.zeros((dof, 4), dtype=np.float64), np.zeros(dof, dtype=np.float64),
+        np.zeros((dof, dof), dtype=np.float64))
 
 
 

@@ -148,6 +148,7 @@ def _warm_connect_and_certificate() -> None:
 
     s = _warm_scenario()
     plan_scenario(s, planner="fuzzy-rrt-connect", seed=0, max_iter=20, trace=True)
+    _warm_training("goal-frame-any")  # its population runs the connect kernel just compiled
     # The certificate and the exact minimum clearance (measured lazily, so no plan above
     # compiled them): tests with a time limit must not pay for their first compile.
     from xfuzzy_rrt.geometry.path_check import certify_path, path_min_clearance

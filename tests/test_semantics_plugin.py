@@ -16,7 +16,7 @@ import pytest
 
 from xfuzzy_rrt.fuzzy import semantics as sem
 from xfuzzy_rrt.planners import fuzzy_rrt
-from xfuzzy_rrt.training import genome
+from xfuzzy_rrt.training import evaluate, genome
 from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for, memo_population
 
 CALLS: list[int] = []
@@ -79,13 +79,18 @@ def test_the_builtin_semantics_declare_the_kernels_integers():
     assert dict(sem.GOAL_FRAME.modes) == {"goal-frame": fuzzy_rrt.GOAL_FRAME}
     assert sem.resolve(sem.PAPER.kernel) is fuzzy_rrt.fuzzy_rrt_entry
     assert sem.resolve(sem.GOAL_FRAME.kernel) is fuzzy_rrt.goal_frame_entry
-    assert genome.MODES == ("absolute", "relative", "goal-frame")
+    assert genome.MODES == ("absolute", "relative", "goal-frame", "goal-frame-any")
     for s in (sem.PAPER, sem.GOAL_FRAME):
         for dof in range(sem.MIN_DOF, sem.MAX_DOF + 1):  # the plug-in survives for_dof
             at = s.for_dof(dof)
             assert (at.modes, at.kernel, at.population, at.per_arm) == \
                 (s.modes, s.kernel, s.population, s.per_arm)
-    assert not sem.GOAL_FRAME_ANY.modes and sem.GOAL_FRAME_ANY.planner == "fuzzy-rrt-connect"
+    # trained with the planner that runs it; Fuzzy-RRT has no kernel for it
+    any_ = sem.GOAL_FRAME_ANY
+    assert dict(any_.modes) == {"goal-frame-any": 3} and any_.kernel is None
+    assert any_.planner == "fuzzy-rrt-connect" and "work" in any_.measures
+    assert sem.resolve(any_.population) is evaluate.connect_population
+    assert all(any_.for_dof(dof) is any_ for dof in range(sem.MIN_DOF, sem.MAX_DOF + 1))
 
 
 def test_a_semantics_cannot_take_another_ones_inputs_or_modes():

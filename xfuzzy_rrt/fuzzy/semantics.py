@@ -51,7 +51,8 @@ with every joint-space length (distance, clearance, ahead, behind, side, step) i
 degrees*: Euclidean joint-space degrees divided by ``sqrt(N/2)`` (:func:`length_scale`). At
 N = 2 every number is goal-frame's; at other N the ranges still hold (the distance range
 ``180*sqrt(2N)`` normalises to 360), so one rulebook plans 2 to 7 joints and several arms.
-Only Fuzzy-RRT-Connect (:mod:`xfuzzy_rrt.planners.connect`) plans with it so far.
+Only Fuzzy-RRT-Connect (:mod:`xfuzzy_rrt.planners.connect`) plans with it, and training
+(``train --bounds goal-frame-any``) runs that planner, on problems of any DOF mixed.
 """
 
 from __future__ import annotations
@@ -92,7 +93,8 @@ class Semantics:
     # registered from above may give the function itself).
     #: Training modes (``train --bounds``) this semantics offers -> the integer mode its
     #: compiled kernel takes (the first is the mode of a rulebook without ``bounds_mode``);
-    #: empty: Fuzzy-RRT does not plan with it, nor does training make it.
+    #: empty: training does not make it. Fuzzy-RRT plans with it only when it has a
+    #: :attr:`kernel`.
     modes: Mapping[str, int] = field(default_factory=lambda: MappingProxyType({}))
     #: The Fuzzy-RRT kernel entry (plain-tuple arguments, the signature of
     #: ``planners/fuzzy_rrt.py:fuzzy_rrt_entry``), or ``None``.
@@ -225,6 +227,11 @@ GOAL_FRAME_ANY = Semantics(
             "length in normalised degrees (Euclidean degrees / sqrt(N/2), N joints in all), so "
             "one rulebook plans 2 to 7 joints and several arms",
     dof_free=True,
+    # trained with Fuzzy-RRT-Connect, the planner that runs it (no Fuzzy-RRT kernel: mode 3
+    # names the training evaluation only)
+    modes=_ro({"goal-frame-any": 3}),
+    population="xfuzzy_rrt.training.evaluate:connect_population",
+    measures=("iterations", "work"),
     planner="fuzzy-rrt-connect",
 )
 

@@ -27,6 +27,8 @@ import numpy as np
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy import semantics as _sem
+from xfuzzy_rrt.geometry.problem import Problem
+from xfuzzy_rrt.planners.connect import connect_kernel
 from xfuzzy_rrt.planners.fuzzy_rrt import GOAL_FRAME, MIN_STEP_DEG, fuzzy_rrt_kernel
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.trace_record import make_trace
@@ -177,6 +179,62 @@ def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, s
                                        buffers)
     return run_population(pr.bundle, tree, knots_b, consts_b, mode, seeds, int(max_iter),
                           MIN_STEP_DEG, np.zeros(1, dtype=np.int64), buffers)
+
+
+@nb.njit(cache=True, nogil=True, _nrt=True)
+def connect_population_measured(P, TA, TB, knots_b, consts_b, seeds, max_iter, scale, min_step,
+                                stop, TR, grown, connect_nodes, counts):
+    """:func:`run_population_measured` for Fuzzy-RRT-Connect (the ``goal-frame-any``
+    semantics): iterations (``-1`` failed) and work of every (individual, seed) run,
+    int64[P, R, 2], through the planner's own :func:`~xfuzzy_rrt.planners.connect.connect_kernel`.
+
+    ``TA``/``TB`` are the two trees (:func:`~xfuzzy_rrt.planners.connect.tree_capacity` nodes
+    each), emptied before each run; the goal tree's view of the problem (start and goal
+    swapped) is built here and shares ``P.work``, as in the planner; ``scale`` is the
+    problem's length scale (``sqrt(N / 2)``). The work is what ``PlanResult.work`` counts:
+    distance evaluations of both directions plus both trees' nearest-neighbour visits.
+    """
+    n_ind = knots_b.shape[0]
+    n_seeds = seeds.shape[0]
+    out = np.empty((n_ind, n_seeds, 2), dtype=np.int64)
+    PR = Problem(P.links, P.arm_first, P.bases, P.radii, P.obstacles, P.limits, P.goal, P.start,
+                 P.margin, P.clearance, P.work)
+    meta_a = TA.meta.copy()
+    meta_b = TB.meta.copy()
+    record = n_seeds < 0  # a run-time False: see run_population_measured
+    for p in range(n_ind):
+        for r in range(n_seeds):
+            reset_tree(TA, meta_a)
+            reset_tree(TB, meta_b)
+            work0 = P.work[0]
+            ok, iterations, _, _ = connect_kernel(
+                P, PR, TA, TB, seeds[r], max_iter, knots_b[p], consts_b[p], scale, min_step,
+                stop, record, TR, grown, connect_nodes, counts)
+            out[p, r, 0] = iterations if ok else -1
+            out[p, r, 1] = P.work[0] - work0 + TA.meta[NN_VISITS] + TB.meta[NN_VISITS]
+    return out
+
+
+def connect_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, seeds,
+                       max_iter: int, measure: str = "iterations") -> np.ndarray:
+    """The ``population`` of the ``goal-frame-any`` semantics: Fuzzy-RRT-Connect runs
+    (:func:`connect_population_measured`) on two trees of its own (``tree``, one tree sized
+    for Fuzzy-RRT, is not used); int64[P, R], or int64[P, R, 2] with ``measure="work"``."""
+    from xfuzzy_rrt.fuzzy.semantics import GOAL_FRAME_ANY, length_scale
+    from xfuzzy_rrt.planners.connect import tree_capacity
+
+    cap = tree_capacity(max_iter)
+    ta = make_tree(cap, pr.limits)
+    tb = make_tree(cap, pr.limits)
+    buffers = make_trace(1, pr.dof, knots_b.shape[1], 1)
+    rows = (np.zeros(1, dtype=np.int8), np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
+    # a work counter of this call's own (Dask threads share problem objects)
+    bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))
+    out = connect_population_measured(
+        bundle, ta, tb, _read_only(knots_b), _read_only(consts_b), seeds, int(max_iter),
+        length_scale(GOAL_FRAME_ANY, pr.dof), MIN_STEP_DEG, np.zeros(1, dtype=np.int64),
+        buffers, *rows)
+    return out if measure == "work" else out[:, :, 0].copy()
 
 
 def memo_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, seeds,

@@ -87,13 +87,27 @@ def scenario_dof(scenario, bounds: str) -> int:
 
 def training_dof(scenarios, bounds: str, dof: int | None = None) -> int:
     """The DOF to train: that of the scenarios (which must agree), or ``--dof`` (which must
-    agree with them). *scenarios* are :class:`TrainingScenario` or scenario objects.
+    agree with them). *scenarios* are :class:`TrainingScenario` or scenario objects. A DOF-free
+    semantics (``goal-frame-any``) takes scenarios of any DOF and no ``--dof``; its semantics
+    object says 2, which is what this returns for it.
 
     Raises :class:`InputError` (one line) for scenarios of different DOF or a ``--dof`` that
     disagrees with them, naming a file of each DOF.
     """
     from xfuzzy_rrt.fuzzy import semantics as _sem
 
+    sem = _sem.of_mode(bounds)
+    if sem.dof_free:  # one rulebook for every arm: scenarios of any DOF train it together
+        if dof is not None:
+            raise InputError("--dof", f"a {sem.name} rulebook plans any number of joints; "
+                             "train it without --dof")
+        for t in scenarios:
+            s = getattr(t, "scenario", t)
+            problem = _sem.dof_problem(int(s.dof)) if len(s.arms) == 1 else None
+            if problem:
+                raise InputError(str(getattr(t, "path", None) or s.source or s.name),
+                                 f"no rulebook for this arm: {problem}")
+        return _sem.DEFAULT_DOF
     if dof is not None:
         problem = _sem.dof_problem(dof)
         if problem:
@@ -154,6 +168,13 @@ def default_seed_rulebook(dof: int = 2) -> str:
     return DEFAULT_SEED_RULEBOOK if dof == 2 else f"{DEFAULT_SEED_RULEBOOK}-{dof}dof"
 
 
+def _seeds(have: str, want: str) -> bool:
+    """Can a rulebook of semantics *have* seed a training of semantics *want*? The same one,
+    or a 2-DOF goal-frame rulebook for goal-frame-any: the same inputs, outputs and ranges
+    (goal-frame-any's in normalised degrees, which are goal-frame's degrees at 2 joints)."""
+    return have == want or (have, want) == ("goal-frame", "goal-frame-any")
+
+
 def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str,
                            dof: int = 2) -> list[SeedRulebook]:
     """The seed rulebooks of a training run, loaded and checked.
@@ -190,7 +211,7 @@ def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str,
                              f"{dof}")
         want = of_mode(bounds)  # the semantics --bounds trains
         if bounds not in BOUNDS_MODES:  # a semantics without the paper's bounds modes
-            if rb.semantics.name != want.name:
+            if not _seeds(rb.semantics.name, want.name):
                 raise InputError(str(p), f"seed rulebook is not a {want.name} rulebook, but "
                                  f"--bounds is {bounds}")
         elif rb.semantics.name != want.name or rb.bounds_mode != bounds:

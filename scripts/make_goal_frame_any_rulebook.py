@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
-"""Generate ``rulebooks/goal-frame-any/``: the first rulebook of the DOF-free ``goal-frame-any``
-semantics, carried over from the shipped (trained, 2-joint) ``goal-frame`` rulebook.
+"""Write ``goal-frame``'s knots and rules as a ``goal-frame-any`` rulebook: what the first
+shipped ``rulebooks/goal-frame-any/`` was (until ``b08627d``), and what the trained one now
+starts from (``train --bounds goal-frame-any --seed-rulebook rulebooks/goal-frame`` encodes
+the same genome; rulebooks/README.md has the command).
 
 Why this is a faithful starting point: ``goal-frame-any`` measures every joint-space length in
 normalised degrees (Euclidean degrees divided by ``sqrt(N/2)``, ``N`` joints in all; see
@@ -8,13 +10,13 @@ normalised degrees (Euclidean degrees divided by ``sqrt(N/2)``, ``N`` joints in 
 its input and output ranges are goal-frame's 2-joint ranges. So the same knots and rule
 constants make the same decisions at two joints and the *same per-joint* decisions at any
 other number of joints: a step of 15 normalised degrees moves each of N joints about as far as
-a 15-degree step moves each of two. Nothing here was trained for N > 2 (training a
-goal-frame-any rulebook on a mixture of arms is the next step, see issue 25).
+a 15-degree step moves each of two. Nothing here was trained for N > 2; the shipped
+``goal-frame-any`` is, on a mixture of 3 to 7 joints and two arms.
 
 Usage::
 
-    python scripts/make_goal_frame_any_rulebook.py [--source rulebooks/goal-frame]
-        [--out rulebooks/goal-frame-any] [--date YYYY-MM-DD]
+    python scripts/make_goal_frame_any_rulebook.py --out DIR [--source rulebooks/goal-frame]
+        [--date YYYY-MM-DD]
 """
 
 from __future__ import annotations
@@ -31,7 +33,8 @@ from xfuzzy_rrt.fuzzy.rulebook import Rulebook, load_rulebook, rulebooks_dir, sa
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--source", default=str(rulebooks_dir() / "goal-frame"))
-    p.add_argument("--out", default=str(rulebooks_dir() / "goal-frame-any"))
+    # no default: the shipped rulebooks/goal-frame-any is trained now, not this copy
+    p.add_argument("--out", required=True)
     p.add_argument("--date", default=dt.date.today().isoformat())
     args = p.parse_args(argv)
     src = load_rulebook(args.source)

@@ -120,3 +120,17 @@ def test_dof_is_refused_in_one_line_for_a_dof_free_training(tmp_path):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "--dof" in lines[0] and "any number of joints" in lines[0]
     assert not (tmp_path / "rb").exists()
+
+
+@pytest.mark.parametrize("seed_rb,says", [("goal-frame-5dof", "2-joint goal-frame"),
+                                          ("expert", "not a goal-frame-any rulebook")])
+def test_a_seed_rulebook_it_cannot_start_from_is_refused_in_one_line(tmp_path, seed_rb, says):
+    scenario = _write(tmp_path, 46, 0, 3, 1)
+    proc = subprocess.run([console_script(), "train", "--scenario", str(scenario), "--bounds",
+                           "goal-frame-any", "--seed-rulebook", str(rulebooks_dir() / seed_rb),
+                           "--out", str(tmp_path / "rb")], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and seed_rb in lines[0] and says in lines[0], lines
+    assert not (tmp_path / "rb").exists()

@@ -114,6 +114,13 @@ class Semantics:
     per_arm: bool = False
     #: The planner label that plans with it when nothing else is said.
     planner: str = "fuzzy-rrt"
+    #: Other semantics whose (2-DOF) rulebooks may seed a training of this one: the same
+    #: inputs, outputs and ranges, so the same genome (:meth:`can_seed_from`).
+    seeded_by: tuple[str, ...] = ()
+
+    def can_seed_from(self, name: str) -> bool:
+        """May a rulebook of semantics *name* seed a training of this one?"""
+        return name == self.name or name in self.seeded_by
 
     @property
     def n_outputs(self) -> int:
@@ -233,6 +240,8 @@ GOAL_FRAME_ANY = Semantics(
     population="xfuzzy_rrt.training.evaluate:connect_population",
     measures=("iterations", "work"),
     planner="fuzzy-rrt-connect",
+    # goal-frame's lengths are its normalised degrees at 2 joints: the same genome
+    seeded_by=("goal-frame",),
 )
 
 #: The registry: name -> semantics at 2 DOF (a live read-only view; :func:`register` adds).

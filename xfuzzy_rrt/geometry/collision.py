@@ -369,18 +369,39 @@ def n_link_pairs(P):
 def clearance_kernel(P, q_deg):
     """Smallest distance between any link capsule and any obstacle, any other arm's capsule or
     a non-adjacent link of its own arm (<= 0: collision); ``inf`` with nothing to touch. Joint
-    limits are not considered.
+    limits are not considered. Allocates a segment buffer only when there are link pairs
+    (:func:`clearance_into` takes one instead).
     """
-    return clearance_into(P, q_deg, np.empty((P.links.shape[0], 4)))
+    best = _obstacle_clearance(P, q_deg)
+    if _has_link_pairs(P):
+        best = min(best, _link_pair_clearance(P, q_deg, np.empty((P.links.shape[0], 4))))
+    P.work[0] += n_distance_pairs(P)
+    return best
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
 def clearance_into(P, q_deg, seg):
     """:func:`clearance_kernel` with the link-segment buffer ``seg`` ``[L, 4]`` given: what the
-    planners' loops call with their tree's buffer (:func:`edge_free_into`), allocating nothing."""
+    planners' loops call with their tree's buffer (:func:`edge_free_into`), allocating nothing.
+    Same value, same work."""
+    best = _obstacle_clearance(P, q_deg)
+    if _has_link_pairs(P):
+        best = min(best, _link_pair_clearance(P, q_deg, seg))
+    P.work[0] += n_distance_pairs(P)
+    return best
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _has_link_pairs(P):
+    """Two arms, or an arm of three links or more: link pairs that can touch."""
+    return P.arm_first.shape[0] > 2 or has_self_pairs(P)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _obstacle_clearance(P, q_deg):
+    """Smallest link-capsule to obstacle distance (``inf``: no obstacle)."""
     best = np.inf
-    n_arms = P.arm_first.shape[0] - 1
-    for a in range(n_arms):
+    for a in range(P.arm_first.shape[0] - 1):
         x = P.bases[a, 0]
         y = P.bases[a, 1]
         theta = 0.0
@@ -389,14 +410,19 @@ def clearance_into(P, q_deg, seg):
             best = min(best, _link_clearance(x, y, nx, ny, P.radii[a], P.obstacles))
             x = nx
             y = ny
-    has_self = has_self_pairs(P)
-    if n_arms > 1 or has_self:
-        link_segments_into(P, q_deg, seg)
-        if n_arms > 1:
-            best = min(best, arm_arm_clearance(P, seg))
-        if has_self:
-            best = min(best, self_clearance(P, seg))
-    P.work[0] += n_distance_pairs(P)
+    return best
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _link_pair_clearance(P, q_deg, seg):
+    """Smallest capsule-capsule distance of links of two arms, then of non-adjacent links of
+    one arm (``inf``: none), with the links' segments written to ``seg``."""
+    link_segments_into(P, q_deg, seg)
+    best = np.inf
+    if P.arm_first.shape[0] > 2:
+        best = min(best, arm_arm_clearance(P, seg))
+    if has_self_pairs(P):
+        best = min(best, self_clearance(P, seg))
     return best
 
 

@@ -131,6 +131,14 @@ def _same(a, b):
     return True
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def reversed_problem(P):
+    """The goal tree's view of ``P``: start and goal swapped, everything else (the work
+    counter included) shared, so its extensions join the start directly when they can."""
+    return Problem(P.links, P.arm_first, P.bases, P.radii, P.obstacles, P.limits, P.goal,
+                   P.start, P.margin, P.clearance, P.work)
+
+
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
                    TR, grown, connect_nodes, counts):
@@ -371,11 +379,13 @@ def finish_connect_run(nodes_a, parent_a, na, nodes_b, parent_b, nb_, last_a, la
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def connect_entry(p, pr, ta, tb, seed, max_iter, knots, consts, scale, min_step, stop, record,
+def connect_entry(p, ta, tb, seed, max_iter, knots, consts, scale, min_step, stop, record,
                   tr, grown, connect_nodes, counts):
     """:func:`connect_kernel` with the problem, tree and trace bundles as *plain* tuples (typed
-    by numba's fast C path; see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`)."""
-    return connect_kernel(Problem(*p), Problem(*pr), TreeArrays(*ta), TreeArrays(*tb), seed,
+    by numba's fast C path; see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the goal tree's
+    view of the problem is built here (:func:`reversed_problem`), not unboxed a second time."""
+    P = Problem(*p)
+    return connect_kernel(P, reversed_problem(P), TreeArrays(*ta), TreeArrays(*tb), seed,
                           max_iter, knots, consts, scale, min_step, stop, record,
                           TraceArrays(*tr), grown, connect_nodes, counts)
 
@@ -394,7 +404,6 @@ class _Setup(NamedTuple):
     consts: np.ndarray
     scale: float
     forward_head: tuple
-    reverse_head: tuple
 
 
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -407,11 +416,9 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     knots, consts = rb.compiled
     scale = length_scale(rb.semantics, scenario.dof)
     a = scenario_arrays(scenario)
-    problem = a.problem(margin)
-    reverse = problem._replace(start=problem.goal, goal=problem.start)
-    # all but the work counter, fresh per call and shared by both directions
+    # all but the work counter, fresh per call (both directions share it: reversed_problem)
     return _Setup(rb, a, margin, int(max_iter), float(params["min_step_deg"]), params, knots,
-                  consts, scale, tuple(problem)[:-1], tuple(reverse)[:-1])
+                  consts, scale, tuple(a.problem(margin))[:-1])
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -446,7 +453,6 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
     work = new_work_counter()  # one count for both directions
     problem = (*setup.forward_head, work)
-    reverse = (*setup.reverse_head, work)
     cap = tree_capacity(max_iter)
     ta = empty_tree(cap, a.limits_deg, slot=0)
     tb = empty_tree(cap, a.limits_deg, slot=1)
@@ -456,7 +462,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     grown = np.zeros(rows, dtype=np.int8)
     connect_nodes = np.zeros(rows, dtype=np.int64)
     counts = np.zeros(1, dtype=np.int64)
-    args = (problem, reverse, tuple(ta), tuple(tb), int(seed))
+    args = (problem, tuple(ta), tuple(tb), int(seed))
     tail = (knots, consts, scale, min_step)
 
     def run(iters, stop):

@@ -27,8 +27,7 @@ import numpy as np
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy import semantics as _sem
-from xfuzzy_rrt.geometry.problem import Problem
-from xfuzzy_rrt.planners.connect import connect_kernel
+from xfuzzy_rrt.planners.connect import connect_kernel, reversed_problem
 from xfuzzy_rrt.planners.fuzzy_rrt import GOAL_FRAME, MIN_STEP_DEG, fuzzy_rrt_kernel
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.trace_record import make_trace
@@ -197,8 +196,7 @@ def connect_population_measured(P, TA, TB, knots_b, consts_b, seeds, max_iter, s
     n_ind = knots_b.shape[0]
     n_seeds = seeds.shape[0]
     out = np.empty((n_ind, n_seeds, 2), dtype=np.int64)
-    PR = Problem(P.links, P.arm_first, P.bases, P.radii, P.obstacles, P.limits, P.goal, P.start,
-                 P.margin, P.clearance, P.work)
+    PR = reversed_problem(P)
     meta_a = TA.meta.copy()
     meta_b = TB.meta.copy()
     record = n_seeds < 0  # a run-time False: see run_population_measured

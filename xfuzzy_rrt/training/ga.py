@@ -216,12 +216,13 @@ def seed_genomes(bounds: str, rulebooks=(), dof: int = _sem.DEFAULT_DOF) -> list
         if rb.dof != dof:
             raise ValueError(f"seed rulebook {rb.name!r} is for dof {rb.dof}, the training "
                              f"for dof {dof}")
-    if bounds in ("goal-frame", "goal-frame-any"):
+    sem = _sem.of_mode(bounds)
+    if sem.outputs == _sem.GOAL_FRAME.outputs:  # goal-frame and the semantics sharing its outputs
         out = [(f"goal-frame-{i}", constant_outputs_genome(v, bounds, dof))
                for i, v in enumerate(GOAL_FRAME_SEEDS)]
         for rb in rulebooks:
-            if rb.semantics.name not in ("goal-frame", bounds):  # see run._seeds
-                raise ValueError(f"seed rulebook {rb.name!r} is not a {bounds} rulebook")
+            if not sem.can_seed_from(rb.semantics.name):
+                raise ValueError(f"seed rulebook {rb.name!r} is not a {sem.name} rulebook")
             out.append((rb.name, encode(*rb.arrays(), bounds, dof)))
         return out
     full = (-180.0, 180.0) * dof

@@ -168,13 +168,6 @@ def default_seed_rulebook(dof: int = 2) -> str:
     return DEFAULT_SEED_RULEBOOK if dof == 2 else f"{DEFAULT_SEED_RULEBOOK}-{dof}dof"
 
 
-def _seeds(have: str, want: str) -> bool:
-    """Can a rulebook of semantics *have* seed a training of semantics *want*? The same one,
-    or a 2-DOF goal-frame rulebook for goal-frame-any: the same inputs, outputs and ranges
-    (goal-frame-any's in normalised degrees, which are goal-frame's degrees at 2 joints)."""
-    return have == want or (have, want) == ("goal-frame", "goal-frame-any")
-
-
 def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str,
                            dof: int = 2) -> list[SeedRulebook]:
     """The seed rulebooks of a training run, loaded and checked.
@@ -206,12 +199,16 @@ def resolve_seed_rulebooks(paths: list[Path] | None, init: str, bounds: str,
     out = []
     for p in paths:
         rb = load_rulebook(p)  # a missing or broken folder is the usual one-line error
+        want = of_mode(bounds)  # the semantics --bounds trains
+        if want.dof_free and rb.dof != dof:  # the 2-DOF semantics object: see training_dof
+            raise InputError(str(p), f"seed rulebook is for dof {rb.dof}; a {want.name} "
+                             f"training is seeded by {want.name} rulebooks or 2-joint "
+                             f"{' or '.join(want.seeded_by)} ones")
         if rb.dof != dof:
             raise InputError(str(p), f"seed rulebook is for dof {rb.dof}, the training for dof "
                              f"{dof}")
-        want = of_mode(bounds)  # the semantics --bounds trains
         if bounds not in BOUNDS_MODES:  # a semantics without the paper's bounds modes
-            if not _seeds(rb.semantics.name, want.name):
+            if not want.can_seed_from(rb.semantics.name):
                 raise InputError(str(p), f"seed rulebook is not a {want.name} rulebook, but "
                                  f"--bounds is {bounds}")
         elif rb.semantics.name != want.name or rb.bounds_mode != bounds:

@@ -1,4 +1,4 @@
-"""2-DOF kernel time now against a pinned earlier commit, in one run, as a ratio.
+"""Kernel (or whole-call) time now against a pinned earlier commit, in one run, as a ratio.
 
 Why: golden files pin results, nothing pinned speed, and the N-DOF core change made 2-DOF
 kernels 1.4-2.1x slower unnoticed (issue 24). Timing two versions in two sessions compares two
@@ -9,8 +9,9 @@ How: the old commit is checked out in a temporary worktree (``git worktree add``
 version runs in its own worker process (``PYTHONPATH`` = its tree, its own shipped rulebooks);
 each worker prints where it imported ``xfuzzy_rrt`` from, and the script refuses to go on if
 that is not the tree it asked for. The measure is the planner's own kernel timer
-(``PlanResult.wall_s``); both versions must need the same iterations (same seeds, same
-results), else the line is flagged. Printed: per planner and problem the median kernel time of
+(``PlanResult.wall_s``), or with ``--measure call`` the whole ``plan_scenario`` call (what a
+user waits for); both versions must need the same iterations (same seeds, same results), else
+the line is flagged. Printed: per planner and problem the median kernel time of
 both and their ratio, the ratio of their deterministic work counts (``PlanResult.work``, summed
 over the seeds; ``-`` when a version does not count), then the geometric mean of the time
 ratios per planner.
@@ -36,7 +37,7 @@ BASELINE = "8782882"
 PLANNERS = ("rrt", "fuzzy-rrt")
 
 WORKER = r"""
-import json, sys
+import json, sys, time
 import xfuzzy_rrt
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.api import plan_scenario
@@ -47,8 +48,10 @@ for line in sys.stdin:
     s = cache.get(job["scenario"]) or cache.setdefault(job["scenario"], load_scenario(job["scenario"]))
     walls = []
     for _ in range(job["repeat"]):
+        t0 = time.perf_counter()
         r = plan_scenario(s, job["planner"], seed=job["seed"])
-        walls.append(r.wall_s)
+        call = time.perf_counter() - t0
+        walls.append(call if job["measure"] == "call" else r.wall_s)
     print(json.dumps({"wall": min(walls), "iterations": r.iterations,
                       "success": bool(r.success), "work": getattr(r, "work", None)}),
           flush=True)
@@ -67,9 +70,11 @@ class Worker:
             raise SystemExit(f"error: the worker for {tree} imported xfuzzy_rrt from {where}")
         self.tree = tree
 
-    def run(self, scenario: Path, planner: str, seed: int, repeat: int) -> dict:
+    def run(self, scenario: Path, planner: str, seed: int, repeat: int,
+            measure: str = "kernel") -> dict:
         self.proc.stdin.write(json.dumps({"scenario": str(scenario), "planner": planner,
-                                          "seed": seed, "repeat": repeat}) + "\n")
+                                          "seed": seed, "repeat": repeat,
+                                          "measure": measure}) + "\n")
         self.proc.stdin.flush()
         return json.loads(self.proc.stdout.readline())
 
@@ -90,11 +95,14 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--commit", default=BASELINE)
     ap.add_argument("--problems", type=Path, default=Path("/tmp/eval9100"),
-                    help="folder of 2-DOF scenario files (paper-reference is always added)")
+                    help="folder of scenario files (any arms) (paper-reference is always added)")
     ap.add_argument("--count", type=int, default=12, help="problems taken from --problems")
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--repeat", type=int, default=3, help="runs per call; the minimum counts")
     ap.add_argument("--planners", default=",".join(PLANNERS))
+    ap.add_argument("--measure", choices=("kernel", "call"), default="kernel",
+                    help="kernel: the planner's own timer (wall_s); call: the whole "
+                         "plan_scenario call, what a user waits for")
     args = ap.parse_args(argv)
     problems = [REPO / "xfuzzy_rrt" / "data" / "reference" / "paper-reference.toml"]
     if args.problems.is_dir():
@@ -111,7 +119,8 @@ def main(argv=None) -> int:
             for sc in problems:
                 for p in planners:
                     pair = (old, new) if seed % 2 == 0 else (new, old)
-                    got = {w.tree: w.run(sc, p, seed, args.repeat) for w in pair}
+                    got = {w.tree: w.run(sc, p, seed, args.repeat, args.measure)
+                           for w in pair}
                     rows.setdefault((p, sc.stem), []).append((got[old.tree], got[new.tree]))
     finally:
         old.close()

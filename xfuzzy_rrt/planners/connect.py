@@ -99,20 +99,15 @@ from xfuzzy_rrt.planners.rng import seed_state
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
-from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
+from xfuzzy_rrt.planners.prepared import idle_trace, pooled_tree, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
 from xfuzzy_rrt.planners.trace_record import TraceArrays
-from xfuzzy_rrt.planners.tree import (
-    NN_VISITS,
-    TreeArrays,
-    add_node,
-    nearest,
-    reset_tree,
-)
+from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
+from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
 PLANNER = "fuzzy-rrt-connect"
-#: The rulebook used without one: the shipped DOF-free rulebook (any arm; at 2 joints it decides
-#: exactly as the goal-frame rulebook).
+#: The rulebook used without one: the shipped DOF-free rulebook (any arm; trained on 3 to 7
+#: joints and two arms, rulebooks/README.md).
 DEFAULT_RULEBOOK = "goal-frame-any"
 START_TREE = 0
 GOAL_TREE = 1
@@ -379,15 +374,17 @@ def finish_connect_run(nodes_a, parent_a, na, nodes_b, parent_b, nb_, last_a, la
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def connect_entry(p, ta, tb, seed, max_iter, knots, consts, scale, min_step, stop, record,
-                  tr, grown, connect_nodes, counts):
-    """:func:`connect_kernel` with the problem, tree and trace bundles as *plain* tuples (typed
-    by numba's fast C path; see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the goal tree's
-    view of the problem is built here (:func:`reversed_problem`), not unboxed a second time."""
+def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots, consts, scale,
+                  min_step, stop, record, tr, grown, connect_nodes, counts):
+    """:func:`connect_kernel` with the problem and trace bundles as *plain* tuples and the two
+    trees as their arenas, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the
+    goal tree's view of the problem is built here (:func:`reversed_problem`), not unboxed a
+    second time."""
     P = Problem(*p)
-    return connect_kernel(P, reversed_problem(P), TreeArrays(*ta), TreeArrays(*tb), seed,
-                          max_iter, knots, consts, scale, min_step, stop, record,
-                          TraceArrays(*tr), grown, connect_nodes, counts)
+    return connect_kernel(P, reversed_problem(P), emptied_tree_in(block_a, layout_a),
+                          emptied_tree_in(block_b, layout_b), seed, max_iter, knots, consts,
+                          scale, min_step, stop, record, TraceArrays(*tr), grown,
+                          connect_nodes, counts)
 
 
 class _Setup(NamedTuple):
@@ -404,6 +401,9 @@ class _Setup(NamedTuple):
     consts: np.ndarray
     scale: float
     forward_head: tuple
+    #: the untraced call's trace arguments (one-row buffers never written): the trace tuple,
+    #: ``grown`` and ``connect_nodes``
+    idle: tuple
 
 
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -417,8 +417,10 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     scale = length_scale(rb.semantics, scenario.dof)
     a = scenario_arrays(scenario)
     # all but the work counter, fresh per call (both directions share it: reversed_problem)
+    idle = (tuple(idle_trace(a.dof, knots.shape[0], 1)), np.zeros(1, dtype=np.int8),
+            np.zeros(1, dtype=np.int64))
     return _Setup(rb, a, margin, int(max_iter), float(params["min_step_deg"]), params, knots,
-                  consts, scale, tuple(a.problem(margin))[:-1])
+                  consts, scale, tuple(a.problem(margin))[:-1], idle)
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -454,19 +456,22 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     work = new_work_counter()  # one count for both directions
     problem = (*setup.forward_head, work)
     cap = tree_capacity(max_iter)
-    ta = empty_tree(cap, a.limits_deg, slot=0)
-    tb = empty_tree(cap, a.limits_deg, slot=1)
-    rows = max_iter if trace else 1
-    buffers = (make_trace(rows, a.dof, knots.shape[0], 1) if trace
-               else idle_trace(a.dof, knots.shape[0], 1))
-    grown = np.zeros(rows, dtype=np.int8)
-    connect_nodes = np.zeros(rows, dtype=np.int64)
+    arena_a = pooled_tree(cap, a.limits_deg, slot=0)
+    arena_b = pooled_tree(cap, a.limits_deg, slot=1)
+    ta, tb = arena_a.tree, arena_b.tree
+    if trace:
+        buffers = make_trace(max_iter, a.dof, knots.shape[0], 1)
+        grown = np.zeros(max_iter, dtype=np.int8)
+        connect_nodes = np.zeros(max_iter, dtype=np.int64)
+        tr = tuple(buffers)
+    else:
+        tr, grown, connect_nodes = setup.idle
     counts = np.zeros(1, dtype=np.int64)
-    args = (problem, tuple(ta), tuple(tb), int(seed))
+    args = (problem, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout, int(seed))
     tail = (knots, consts, scale, min_step)
 
     def run(iters, stop):
-        return connect_entry(*args, int(iters), *tail, stop, bool(trace), tuple(buffers), grown,
+        return connect_entry(*args, int(iters), *tail, stop, bool(trace), tr, grown,
                              connect_nodes, counts)
 
     recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
@@ -476,10 +481,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         ok, iterations, last_a, last_b = run(max_iter, NEVER_STOPPED)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        meta_a, meta_b = ta.meta.copy(), tb.meta.copy()
-        run(0, np.zeros(1, dtype=np.int64))
-        reset_tree(ta, meta_a)
-        reset_tree(tb, meta_b)
+        run(0, np.zeros(1, dtype=np.int64))  # the next run empties the trees again
         work[0] = 0
         counts[0] = 0
         with StopFlag(max_time_s) as flag:

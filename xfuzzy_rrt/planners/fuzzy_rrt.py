@@ -71,9 +71,10 @@ from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_resu
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
-from xfuzzy_rrt.planners.prepared import empty_tree, idle_trace, scenario_arrays
+from xfuzzy_rrt.planners.prepared import idle_trace, pooled_tree, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
-from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, nearest, reset_tree
+from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
+from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
 MIN_STEP_DEG = default("fuzzy-rrt", "min_step_deg")
@@ -267,19 +268,20 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def fuzzy_rrt_entry(p, t, seed, max_iter, knots, consts, bounds_mode, min_step, stop, record,
-                    tr):
-    """:func:`fuzzy_rrt_kernel` with the problem, tree and trace bundles as *plain* tuples
-    (typed by numba's fast C path; see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`)."""
-    return fuzzy_rrt_kernel(Problem(*p), TreeArrays(*t), seed, max_iter, knots, consts,
-                            bounds_mode, min_step, stop, record, TraceArrays(*tr))
+def fuzzy_rrt_entry(p, block, layout, seed, max_iter, knots, consts, bounds_mode, min_step,
+                    stop, record, tr):
+    """:func:`fuzzy_rrt_kernel` with the problem and trace bundles as *plain* tuples and the
+    tree as its arena, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`)."""
+    return fuzzy_rrt_kernel(Problem(*p), emptied_tree_in(block, layout), seed, max_iter, knots,
+                            consts, bounds_mode, min_step, stop, record, TraceArrays(*tr))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def goal_frame_entry(p, t, seed, max_iter, knots, consts, mode, min_step, stop, record, tr):
-    """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, plain tuples as above."""
-    return goal_frame_kernel(Problem(*p), TreeArrays(*t), seed, max_iter, knots, consts, mode,
-                             min_step, stop, record, TraceArrays(*tr))
+def goal_frame_entry(p, block, layout, seed, max_iter, knots, consts, mode, min_step, stop,
+                     record, tr):
+    """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, called as above."""
+    return goal_frame_kernel(Problem(*p), emptied_tree_in(block, layout), seed, max_iter,
+                             knots, consts, mode, min_step, stop, record, TraceArrays(*tr))
 
 
 def entry_for(mode: int):
@@ -379,7 +381,8 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, mode, kernel = setup.knots, setup.consts, setup.mode, setup.kernel
     problem = (*setup.problem_head, new_work_counter())
-    tree = empty_tree(max_iter + 2, a.limits_deg)
+    arena = pooled_tree(max_iter + 2, a.limits_deg)
+    tree, block, layout = arena.tree, arena.block, arena.layout
     buffers = (tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace
                else setup.idle)
     recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
@@ -387,19 +390,17 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
                 "margin_m": float(margin)}
     if max_time_s is None:
         t0 = time.perf_counter()
-        ok, iterations, last = kernel(problem, tuple(tree), int(seed), max_iter, knots, consts,
-                                      mode, setup.min_step, NEVER_STOPPED, bool(trace),
+        ok, iterations, last = kernel(problem, block, layout, int(seed), max_iter, knots,
+                                      consts, mode, setup.min_step, NEVER_STOPPED, bool(trace),
                                       buffers)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        meta0 = tree.meta.copy()
-        kernel(problem, tuple(tree), int(seed), 0, knots, consts, mode, setup.min_step,
+        kernel(problem, block, layout, int(seed), 0, knots, consts, mode, setup.min_step,
                np.zeros(1, dtype=np.int64), bool(trace), buffers)
-        reset_tree(tree, meta0)
         problem[-1][0] = 0
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
-            ok, iterations, last = kernel(problem, tuple(tree), int(seed), max_iter, knots,
+            ok, iterations, last = kernel(problem, block, layout, int(seed), max_iter, knots,
                                           consts, mode, setup.min_step, flag.array,
                                           bool(trace), buffers)
             wall = time.perf_counter() - t0

@@ -18,7 +18,8 @@ from collections import OrderedDict
 import numpy as np
 
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace
-from xfuzzy_rrt.planners.tree import TreeArrays, make_tree
+from xfuzzy_rrt.planners.tree import TreeArrays, reset_tree
+from xfuzzy_rrt.planners.tree_arena import TreeArena, make_tree_arena
 
 #: Trees kept per thread (each up to ``capacity x dof`` floats: 0.6 MB at 10,000 x 7).
 _TREES_PER_THREAD = 4
@@ -42,10 +43,12 @@ def scenario_arrays(scenario):
     return arrays
 
 
-def empty_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeArrays:
-    """An empty tree for ``capacity`` nodes in ``limits_deg``, as :func:`make_tree` makes it,
+def pooled_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeArena:
+    """A tree for ``capacity`` nodes in ``limits_deg`` in one block (:mod:`.tree_arena`),
     reused within this thread from one plan to the next (a result keeps copies, never the
-    tree's arrays). ``slot`` tells apart trees one plan uses at once (Fuzzy-RRT-Connect's two)."""
+    tree's arrays), *not* emptied: the compiled entries empty it
+    (:func:`~xfuzzy_rrt.planners.tree_arena.emptied_tree_in`). ``slot`` tells apart trees one
+    plan uses at once (Fuzzy-RRT-Connect's two)."""
     limits = np.asarray(limits_deg, dtype=np.float64)
     key = (int(capacity), limits.shape, limits.tobytes(), int(slot))
     pool = getattr(_local, "trees", None)
@@ -53,17 +56,20 @@ def empty_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeArra
         pool = _local.trees = OrderedDict()
     hit = pool.get(key)
     if hit is None:
-        tree = make_tree(int(capacity), limits)
-        pool[key] = (tree, tree.meta.copy())
+        hit = pool[key] = make_tree_arena(int(capacity), limits)
         while len(pool) > _TREES_PER_THREAD:
             pool.popitem(last=False)
-        return tree
+        return hit
     pool.move_to_end(key)
-    tree, meta0 = hit
-    tree.meta[:] = meta0
-    tree.cell_head.fill(-1)
-    tree.occ.fill(0)
-    return tree
+    return hit
+
+
+def empty_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeArrays:
+    """:func:`pooled_tree`'s tree, emptied here (as
+    :func:`~xfuzzy_rrt.planners.tree.make_tree` makes it)."""
+    arena = pooled_tree(capacity, limits_deg, slot)
+    reset_tree(arena.tree, arena.meta0)
+    return arena.tree
 
 
 def idle_trace(dof: int, n_out: int, groups: int) -> TraceArrays:

@@ -26,9 +26,10 @@ from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_resu
                                          finish_tree_run)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
-from xfuzzy_rrt.planners.prepared import empty_tree, scenario_arrays
+from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import exact, remembered
-from xfuzzy_rrt.planners.tree import NN_VISITS, TreeArrays, add_node, nearest, reset_tree
+from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
+from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
 DEFAULT_STEP_DEG = default("rrt", "step_deg")
 DEFAULT_GOAL_BIAS = default("rrt", "goal_bias")
@@ -69,14 +70,17 @@ def _rrt_loop(P, T, seed, max_iter, step, goal_bias, stop, state, sample, q_near
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def rrt_entry(p, t, seed, max_iter, step, goal_bias, stop):
-    """:func:`rrt_kernel` called with the problem and the tree as *plain* tuples.
+def rrt_entry(p, block, layout, seed, max_iter, step, goal_bias, stop):
+    """:func:`rrt_kernel` called with the problem as a *plain* tuple and the tree as its
+    arena (:mod:`~xfuzzy_rrt.planners.tree_arena`), emptied here.
 
     Why: numba types a named-tuple argument in Python, element by element, on every call
     (20-40 us for our two bundles, as much as a short 2-DOF plan); a plain tuple of arrays is
-    typed by its fast C path. The bundles are rebuilt here, inside compiled code, for free.
+    typed by its fast C path, and one block instead of the tree's 17 arrays is unboxed once.
+    The bundles are rebuilt here, inside compiled code, for free.
     """
-    return rrt_kernel(Problem(*p), TreeArrays(*t), seed, max_iter, step, goal_bias, stop)
+    return rrt_kernel(Problem(*p), emptied_tree_in(block, layout), seed, max_iter, step,
+                      goal_bias, stop)
 
 
 class _Setup(NamedTuple):
@@ -141,22 +145,21 @@ def plan_rrt_as(label: str, extra_params: dict | None, scenario: Scenario, seed:
     a, margin, params = setup.arrays, setup.margin, setup.params
     max_iter = int(params["max_iter"])
     problem = (*setup.problem_head, new_work_counter())
-    tree = empty_tree(max_iter + 2, a.limits_deg)
+    arena = pooled_tree(max_iter + 2, a.limits_deg)
+    tree, block, layout = arena.tree, arena.block, arena.layout
     step, bias = float(params["step_deg"]), float(params["goal_bias"])
     recorded = dict(setup.recorded)
     if max_time_s is None:
         t0 = time.perf_counter()
-        ok, iterations, last = rrt_entry(problem, tuple(tree), int(seed), max_iter, step, bias,
+        ok, iterations, last = rrt_entry(problem, block, layout, int(seed), max_iter, step, bias,
                                          NEVER_STOPPED)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        meta0 = tree.meta.copy()
-        rrt_entry(problem, tuple(tree), int(seed), 0, step, bias, np.zeros(1, dtype=np.int64))
-        reset_tree(tree, meta0)
+        rrt_entry(problem, block, layout, int(seed), 0, step, bias, np.zeros(1, dtype=np.int64))
         problem[-1][0] = 0
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
-            ok, iterations, last = rrt_entry(problem, tuple(tree), int(seed), max_iter, step,
+            ok, iterations, last = rrt_entry(problem, block, layout, int(seed), max_iter, step,
                                              bias, flag.array)
             wall = time.perf_counter() - t0
         recorded["max_time_s"] = float(params["max_time_s"])

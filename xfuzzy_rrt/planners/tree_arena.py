@@ -1,0 +1,121 @@
+"""A search tree in one block of memory, so that a plan call hands it to compiled code as one
+array instead of seventeen.
+
+Why: numba unboxes every array argument of a compiled call on its own (a reference, a
+bookkeeping record, a check of type and layout: ~60-100 ns each). A Fuzzy-RRT-Connect call took
+two trees of 17 arrays each, plus their reset in Python (two ``fill`` calls and a ``meta`` copy
+per tree); on a 3-joint problem that was ~5 us of a call whose whole planning often takes
+20-50 us. Here the tree's arrays are views into one ``uint8`` block (the *arena*), laid out by
+a small ``layout`` table; a compiled entry rebuilds the :class:`~xfuzzy_rrt.planners.tree.
+TreeArrays` record from the block with slices and ``view``/``reshape`` (no copy, no
+allocation) and empties the tree itself (:func:`emptied_tree_in`). The Python side keeps the
+same arrays as views, so reading ``tree.meta`` or ``tree.nodes`` after a run is unchanged.
+
+What goes in is exactly :func:`~xfuzzy_rrt.planners.tree.make_tree`'s tree (its shapes, dtypes
+and initial values: the fields are copied in), plus ``meta0``, the empty tree's ``meta``, as an
+18th field, so that emptying needs nothing from outside. Fields start at multiples of 64 bytes
+(aligned views: numba types them exactly as the separate arrays were typed).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numba as nb
+import numpy as np
+
+from xfuzzy_rrt.planners.tree import TreeArrays, make_tree, reset_tree
+
+#: dtype and number of dimensions of each :class:`TreeArrays` field, in order; what
+#: :func:`tree_in` rebuilds (``make_tree_arena`` refuses a tree that differs).
+FIELD_KINDS = (
+    (np.float64, 2), (np.int64, 1), (np.int64, 1), (np.int64, 1), (np.int64, 1),
+    (np.float64, 1), (np.int64, 1), (np.int64, 1), (np.int64, 2), (np.float64, 1),
+    (np.float64, 2), (np.float64, 1), (np.float64, 2), (np.uint64, 1), (np.float64, 2),
+    (np.float64, 1), (np.float64, 2),
+)
+#: Row of ``layout`` holding the empty tree's ``meta`` (after the tree's own fields).
+META0 = len(FIELD_KINDS)
+_ALIGN = 64
+
+
+class TreeArena(NamedTuple):
+    """A tree whose arrays are views into ``block`` (``layout[k] = offset, nbytes, rows,
+    cols``; ``cols`` 0 for a 1-D field; row :data:`META0` is ``meta0``)."""
+
+    tree: TreeArrays
+    block: np.ndarray
+    layout: np.ndarray
+    meta0: np.ndarray
+
+
+def make_tree_arena(capacity: int, limits_deg: np.ndarray) -> TreeArena:
+    """:func:`~xfuzzy_rrt.planners.tree.make_tree`'s empty tree, moved into one block."""
+    fresh = make_tree(capacity, limits_deg)
+    parts = list(fresh) + [fresh.meta.copy()]
+    for name, arr, (dtype, ndim) in zip(TreeArrays._fields, fresh, FIELD_KINDS):
+        if arr.dtype != dtype or arr.ndim != ndim:
+            raise TypeError(f"tree field {name} is {arr.dtype}[{arr.ndim}-D]; the arena "
+                            f"expects {np.dtype(dtype)}[{ndim}-D] (FIELD_KINDS)")
+    layout = np.zeros((len(parts), 4), dtype=np.int64)
+    offset = 0
+    for k, arr in enumerate(parts):
+        layout[k] = (offset, arr.nbytes, arr.shape[0], arr.shape[1] if arr.ndim == 2 else 0)
+        offset += -(-arr.nbytes // _ALIGN) * _ALIGN
+    block = np.empty(offset + _ALIGN, dtype=np.uint8)
+    # numpy aligns allocations to 16 bytes; start at the block's first 64-byte boundary
+    shift = (-block.ctypes.data) % _ALIGN
+    layout[:, 0] += shift
+    views = []
+    for k, arr in enumerate(parts):
+        o, n = int(layout[k, 0]), int(layout[k, 1])
+        view = block[o:o + n].view(arr.dtype).reshape(arr.shape)
+        view[...] = arr
+        views.append(view)
+    return TreeArena(TreeArrays(*views[:META0]), block, layout, views[META0])
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _f1(b, L, k):
+    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.float64)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _f2(b, L, k):
+    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.float64).reshape((L[k, 2], L[k, 3]))
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _i1(b, L, k):
+    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.int64)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _i2(b, L, k):
+    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.int64).reshape((L[k, 2], L[k, 3]))
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _u1(b, L, k):
+    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.uint64)
+
+
+@nb.njit(cache=True, nogil=True, _nrt=True)
+def tree_in(block, layout):
+    """The :class:`TreeArrays` whose arrays are ``block``'s fields (views, no copy)."""
+    return TreeArrays(
+        _f2(block, layout, 0), _i1(block, layout, 1), _i1(block, layout, 2),
+        _i1(block, layout, 3), _i1(block, layout, 4), _f1(block, layout, 5),
+        _i1(block, layout, 6), _i1(block, layout, 7), _i2(block, layout, 8),
+        _f1(block, layout, 9), _f2(block, layout, 10), _f1(block, layout, 11),
+        _f2(block, layout, 12), _u1(block, layout, 13), _f2(block, layout, 14),
+        _f1(block, layout, 15), _f2(block, layout, 16))
+
+
+@nb.njit(cache=True, nogil=True, _nrt=True)
+def emptied_tree_in(block, layout):
+    """:func:`tree_in`, emptied for a new run (:func:`~xfuzzy_rrt.planners.tree.reset_tree`
+    with the block's own ``meta0``)."""
+    T = tree_in(block, layout)
+    reset_tree(T, _i1(block, layout, META0))
+    return T

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.fuzzy.rulebook import RULEBOOKS_ENV
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners import registry as _registry
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
@@ -169,13 +171,27 @@ def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
         if spec is None or spec.planner is not entry:
             spec = _PLAIN_SPECS[name] = PlannerSpec(name, entry.kind, None, entry)
         return spec
+    key = (name, os.environ.get(RULEBOOKS_ENV))  # a shipped name's folder follows the variable
+    spec = _PARSED_SPECS.get(key)
+    if spec is not None and spec.planner is entry:
+        return spec
     arg = name[len(entry.label):] if entry.is_prefix else None
-    return PlannerSpec(name, entry.kind, entry.parse_fn(name, arg, where), entry)
+    spec = PlannerSpec(name, entry.kind, entry.parse_fn(name, arg, where), entry)
+    _PARSED_SPECS[key] = spec
+    return spec
 
 
 #: The spec of each exact label without a parse hook (immutable, so made once: plan_scenario
 #: parses its label on every call).
 _PLAIN_SPECS: dict = {}
+#: The spec of each label a parse hook accepted (per value of ``$XFUZZY_RRT_RULEBOOKS``, which
+#: moves the shipped rulebooks; a relative directory stays relative). Why: ``plan_scenario`` parses its label on
+#: every call, and the hooks touch the disk (``fuzzy-rrt:NAME`` stats the rulebook directory,
+#: ``rrt:tuned`` its tuned file): 10-15 us of a 30 us two-joint call. What a hook checked is
+#: checked again where it is used, with the same one-line errors: the rulebook directory when
+#: it is loaded or compared (:func:`~xfuzzy_rrt.fuzzy.rulebook.load_rulebook_cached`), the
+#: tuned file when ``rrt:tuned`` plans (:func:`_tuned_rrt`). Errors are never remembered.
+_PARSED_SPECS: dict = {}
 
 
 def check_planner(name: str, where: str = "--planners") -> str:

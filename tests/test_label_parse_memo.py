@@ -1,0 +1,43 @@
+"""A planner label with an argument is parsed once per process (planners/api.py), yet a
+rulebook folder that goes away still fails with one clear error, and a shipped name follows
+$XFUZZY_RRT_RULEBOOKS."""
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from xfuzzy_rrt.errors import InputError
+from xfuzzy_rrt.fuzzy.rulebook import RULEBOOKS_ENV, rulebooks_dir
+from xfuzzy_rrt.geometry.scenario import load_scenario
+from xfuzzy_rrt.planners.api import parse_planner, plan_scenario
+
+DEMO = Path(__file__).resolve().parents[1] / "xfuzzy_rrt" / "data" / "scenarios" / "demo-gap.toml"
+
+
+def test_a_rulebook_folder_removed_after_its_label_was_parsed_fails_with_one_clear_error(
+        tmp_path):
+    folder = tmp_path / "gf"
+    shutil.copytree(rulebooks_dir() / "goal-frame", folder)
+    label = f"fuzzy-rrt:{folder}"
+    scenario = load_scenario(DEMO)
+    assert plan_scenario(scenario, label, seed=1, max_iter=200).planner == label
+    assert parse_planner(label) is parse_planner(label)  # remembered
+    shutil.rmtree(folder)
+    with pytest.raises(InputError, match=str(folder)):
+        plan_scenario(scenario, label, seed=1, max_iter=200)
+
+
+def test_a_shipped_rulebook_name_follows_the_rulebooks_variable(tmp_path, monkeypatch):
+    before = parse_planner("fuzzy-rrt:goal-frame").rulebook_dir
+    shutil.copytree(rulebooks_dir() / "goal-frame", tmp_path / "goal-frame")
+    monkeypatch.setenv(RULEBOOKS_ENV, str(tmp_path))
+    assert parse_planner("fuzzy-rrt:goal-frame").rulebook_dir == tmp_path / "goal-frame"
+    monkeypatch.delenv(RULEBOOKS_ENV)
+    assert parse_planner("fuzzy-rrt:goal-frame").rulebook_dir == before
+
+
+def test_an_unknown_rulebook_name_is_refused_every_time():
+    for _ in range(2):
+        with pytest.raises(InputError, match="unknown rulebook 'no-such-book'"):
+            parse_planner("fuzzy-rrt:no-such-book")

@@ -177,20 +177,22 @@ def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
         return spec
     arg = name[len(entry.label):] if entry.is_prefix else None
     spec = PlannerSpec(name, entry.kind, entry.parse_fn(name, arg, where), entry)
-    _PARSED_SPECS[key] = spec
+    if spec.rulebook_dir is not None:  # the folder is checked again where it is loaded
+        _PARSED_SPECS[key] = spec
     return spec
 
 
 #: The spec of each exact label without a parse hook (immutable, so made once: plan_scenario
 #: parses its label on every call).
 _PLAIN_SPECS: dict = {}
-#: The spec of each label a parse hook accepted (per value of ``$XFUZZY_RRT_RULEBOOKS``, which
-#: moves the shipped rulebooks; a relative directory stays relative). Why: ``plan_scenario`` parses its label on
-#: every call, and the hooks touch the disk (``fuzzy-rrt:NAME`` stats the rulebook directory,
-#: ``rrt:tuned`` its tuned file): 10-15 us of a 30 us two-joint call. What a hook checked is
-#: checked again where it is used, with the same one-line errors: the rulebook directory when
-#: it is loaded or compared (:func:`~xfuzzy_rrt.fuzzy.rulebook.load_rulebook_cached`), the
-#: tuned file when ``rrt:tuned`` plans (:func:`_tuned_rrt`). Errors are never remembered.
+#: The spec of each rulebook label (``fuzzy-rrt:NAME``, ``fuzzy-rrt-connect:DIR``) its parse
+#: hook accepted, per value of ``$XFUZZY_RRT_RULEBOOKS`` (which moves the shipped rulebooks; a
+#: relative directory stays relative). Why: ``plan_scenario`` parses its label on every call,
+#: and resolving and stat-ing the folder was 10-15 us of a 30 us two-joint call. The folder is
+#: checked again where it is loaded or compared
+#: (:func:`~xfuzzy_rrt.fuzzy.rulebook.load_rulebook_cached`), with the same one-line error.
+#: Other hooks run every time (``ompl:NAME`` must say "needs the extra" under the caller's
+#: option name). Errors are never remembered.
 _PARSED_SPECS: dict = {}
 
 

@@ -76,40 +76,29 @@ def make_tree_arena(capacity: int, limits_deg: np.ndarray) -> TreeArena:
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _f1(b, L, k):
-    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.float64)
+def _raw(b, L, k):
+    """Field ``k``'s bytes."""
+    return b[L[k, 0]:L[k, 0] + L[k, 1]]
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _f2(b, L, k):
-    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.float64).reshape((L[k, 2], L[k, 3]))
-
-
-@nb.njit(cache=True, nogil=True, inline="always")
-def _i1(b, L, k):
-    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.int64)
-
-
-@nb.njit(cache=True, nogil=True, inline="always")
-def _i2(b, L, k):
-    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.int64).reshape((L[k, 2], L[k, 3]))
-
-
-@nb.njit(cache=True, nogil=True, inline="always")
-def _u1(b, L, k):
-    return b[L[k, 0]:L[k, 0] + L[k, 1]].view(np.uint64)
+def _rows(L, k):
+    return (L[k, 2], L[k, 3])
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def tree_in(block, layout):
     """The :class:`TreeArrays` whose arrays are ``block``'s fields (views, no copy)."""
+    f8, i8, L = np.float64, np.int64, layout
     return TreeArrays(
-        _f2(block, layout, 0), _i1(block, layout, 1), _i1(block, layout, 2),
-        _i1(block, layout, 3), _i1(block, layout, 4), _f1(block, layout, 5),
-        _i1(block, layout, 6), _i1(block, layout, 7), _i2(block, layout, 8),
-        _f1(block, layout, 9), _f2(block, layout, 10), _f1(block, layout, 11),
-        _f2(block, layout, 12), _u1(block, layout, 13), _f2(block, layout, 14),
-        _f1(block, layout, 15), _f2(block, layout, 16))
+        _raw(block, L, 0).view(f8).reshape(_rows(L, 0)), _raw(block, L, 1).view(i8),
+        _raw(block, L, 2).view(i8), _raw(block, L, 3).view(i8), _raw(block, L, 4).view(i8),
+        _raw(block, L, 5).view(f8), _raw(block, L, 6).view(i8), _raw(block, L, 7).view(i8),
+        _raw(block, L, 8).view(i8).reshape(_rows(L, 8)), _raw(block, L, 9).view(f8),
+        _raw(block, L, 10).view(f8).reshape(_rows(L, 10)), _raw(block, L, 11).view(f8),
+        _raw(block, L, 12).view(f8).reshape(_rows(L, 12)), _raw(block, L, 13).view(np.uint64),
+        _raw(block, L, 14).view(f8).reshape(_rows(L, 14)), _raw(block, L, 15).view(f8),
+        _raw(block, L, 16).view(f8).reshape(_rows(L, 16)))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
@@ -117,5 +106,5 @@ def emptied_tree_in(block, layout):
     """:func:`tree_in`, emptied for a new run (:func:`~xfuzzy_rrt.planners.tree.reset_tree`
     with the block's own ``meta0``)."""
     T = tree_in(block, layout)
-    reset_tree(T, _i1(block, layout, META0))
+    reset_tree(T, _raw(block, layout, META0).view(np.int64))
     return T

@@ -113,11 +113,14 @@ def test_every_distance_a_query_computes_is_counted(dof):
 
 
 def test_a_plan_counts_its_neighbour_visits_and_a_fresh_tree_starts_at_zero():
-    from xfuzzy_rrt.planners.prepared import empty_tree
+    from xfuzzy_rrt.planners.prepared import pooled_tree
+    from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
     limits = _limits(2)
-    T = empty_tree(100, limits)
+    arena = pooled_tree(100, limits)  # what the planners take, emptied by their entry
+    T = emptied_tree_in(arena.block, arena.layout)
     tr.add_node(T, np.zeros(2), -1)
     tr.nearest(T, np.ones(2))
     assert T.meta[tr.NN_VISITS] == 1
-    assert empty_tree(100, limits).meta[tr.NN_VISITS] == 0
+    again = pooled_tree(100, limits)  # the next plan gets the same tree back, emptied
+    assert emptied_tree_in(again.block, again.layout).meta[tr.NN_VISITS] == 0

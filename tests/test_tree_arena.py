@@ -25,7 +25,9 @@ def test_an_arena_tree_has_make_trees_fields_shapes_and_initial_values(dof):
     for name in ("cell_head", "meta", "grid", "link_clear", "occ", "kd_stack", "mks"):
         np.testing.assert_array_equal(getattr(arena.tree, name), getattr(fresh, name),
                                       err_msg=name)
-    np.testing.assert_array_equal(arena.meta0, fresh.meta)
+    o, n = arena.layout[tree_arena.META0, :2]
+    meta0 = arena.block[o:o + n].view(np.int64)
+    np.testing.assert_array_equal(meta0, fresh.meta)
 
 
 @pytest.mark.parametrize("dof", [2, 5])

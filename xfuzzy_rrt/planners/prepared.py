@@ -4,8 +4,9 @@ trace buffers.
 Why: on a 2-DOF problem the planner's kernel often runs for 0.1-0.5 ms, and building its inputs
 from scratch (a scenario's arrays from the TOML model, a 10,000-node tree, thirteen trace
 buffers that are never written when not tracing) cost as much again. Everything here is an
-exact stand-in for the fresh object: the arrays are the same numbers, the tree is emptied
-(:func:`~xfuzzy_rrt.planners.tree.reset_tree`'s state) before every use, the idle trace
+exact stand-in for the fresh object: the arrays are the same numbers, the tree is emptied by
+the compiled entry before every use (:func:`~xfuzzy_rrt.planners.tree_arena.emptied_tree_in`,
+:func:`~xfuzzy_rrt.planners.tree.reset_tree`'s state), the idle trace
 buffers are never touched. Trees are per thread, so concurrent plans never share one.
 """
 
@@ -18,7 +19,6 @@ from collections import OrderedDict
 import numpy as np
 
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace
-from xfuzzy_rrt.planners.tree import TreeArrays, reset_tree
 from xfuzzy_rrt.planners.tree_arena import TreeArena, make_tree_arena
 
 #: Trees kept per thread (each up to ``capacity x dof`` floats: 0.6 MB at 10,000 x 7).
@@ -62,14 +62,6 @@ def pooled_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeAre
         return hit
     pool.move_to_end(key)
     return hit
-
-
-def empty_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeArrays:
-    """:func:`pooled_tree`'s tree, emptied here (as
-    :func:`~xfuzzy_rrt.planners.tree.make_tree` makes it)."""
-    arena = pooled_tree(capacity, limits_deg, slot)
-    reset_tree(arena.tree, arena.meta0)
-    return arena.tree
 
 
 def idle_trace(dof: int, n_out: int, groups: int) -> TraceArrays:

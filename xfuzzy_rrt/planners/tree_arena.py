@@ -41,12 +41,11 @@ _ALIGN = 64
 
 class TreeArena(NamedTuple):
     """A tree whose arrays are views into ``block`` (``layout[k] = offset, nbytes, rows,
-    cols``; ``cols`` 0 for a 1-D field; row :data:`META0` is ``meta0``)."""
+    cols``; ``cols`` 0 for a 1-D field; row :data:`META0` holds the empty tree's ``meta``)."""
 
     tree: TreeArrays
     block: np.ndarray
     layout: np.ndarray
-    meta0: np.ndarray
 
 
 def make_tree_arena(capacity: int, limits_deg: np.ndarray) -> TreeArena:
@@ -72,7 +71,7 @@ def make_tree_arena(capacity: int, limits_deg: np.ndarray) -> TreeArena:
         view = block[o:o + n].view(arr.dtype).reshape(arr.shape)
         view[...] = arr
         views.append(view)
-    return TreeArena(TreeArrays(*views[:META0]), block, layout, views[META0])
+    return TreeArena(TreeArrays(*views[:META0]), block, layout)
 
 
 @nb.njit(cache=True, nogil=True, inline="always")

@@ -41,3 +41,25 @@ def test_an_unknown_rulebook_name_is_refused_every_time():
     for _ in range(2):
         with pytest.raises(InputError, match="unknown rulebook 'no-such-book'"):
             parse_planner("fuzzy-rrt:no-such-book")
+
+
+def test_rrt_tuned_checks_its_file_on_every_call_though_its_label_is_parsed_once(
+        tmp_path, monkeypatch):
+    from xfuzzy_rrt.planners import tuned
+
+    monkeypatch.setattr(tuned, "tuned_dir", lambda: tmp_path)
+    f = tmp_path / "rrt.toml"
+    f.write_text("[params]\nstep_deg = 60.0\ngoal_bias = 0.1\n")
+    scenario = load_scenario(DEMO)
+    first = plan_scenario(scenario, "rrt:tuned", seed=1, max_iter=300)
+    assert first.params["step_deg"] == 60.0
+    assert parse_planner("rrt:tuned") is parse_planner("rrt:tuned")  # one spec
+    f.write_text("[params]\nstep_deg = 45.0\ngoal_bias = 0.1\n")  # seen at the next call
+    assert plan_scenario(scenario, "rrt:tuned", seed=1, max_iter=300).params["step_deg"] == 45.0
+    f.write_text("[params]\nstep_deg = 45.0\n")  # broken: refused, not the last good values
+    with pytest.raises(InputError, match="needs the tuned file"):
+        plan_scenario(scenario, "rrt:tuned", seed=1, max_iter=300)
+    f.unlink()
+    for _ in range(2):
+        with pytest.raises(InputError, match="needs the tuned file"):
+            parse_planner("rrt:tuned")

@@ -14,7 +14,7 @@ from xfuzzy_rrt.planners import registry as _registry
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
 from xfuzzy_rrt.planners.rng import check_seed
 from xfuzzy_rrt.planners.rrt import plan_rrt, plan_rrt_as
-from xfuzzy_rrt.planners.tuned import tuned_params, tuned_path
+from xfuzzy_rrt.planners.tuned import tuned_path, tuned_record
 
 #: The built-in exact planner names (every accepted label form is in planners/registry.py).
 PLANNERS = ("rrt", "fuzzy-rrt", "fuzzy-rrt-connect")
@@ -171,14 +171,20 @@ def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
         if spec is None or spec.planner is not entry:
             spec = _PLAIN_SPECS[name] = PlannerSpec(name, entry.kind, None, entry)
         return spec
+    arg = name[len(entry.label):] if entry.is_prefix else None
+    spec = _CHECKED_SPECS.get(name)
+    if spec is not None and spec.planner is entry:
+        entry.parse_fn(name, arg, where)  # the hook checks again: its verdict may change
+        return spec
     key = (name, os.environ.get(RULEBOOKS_ENV))  # a shipped name's folder follows the variable
     spec = _PARSED_SPECS.get(key)
     if spec is not None and spec.planner is entry:
         return spec
-    arg = name[len(entry.label):] if entry.is_prefix else None
     spec = PlannerSpec(name, entry.kind, entry.parse_fn(name, arg, where), entry)
     if spec.rulebook_dir is not None:  # the folder is checked again where it is loaded
         _PARSED_SPECS[key] = spec
+    else:
+        _CHECKED_SPECS[name] = spec
     return spec
 
 
@@ -194,6 +200,11 @@ _PLAIN_SPECS: dict = {}
 #: Other hooks run every time (``ompl:NAME`` must say "needs the extra" under the caller's
 #: option name). Errors are never remembered.
 _PARSED_SPECS: dict = {}
+#: The spec of each label whose hook names no rulebook (``rrt:tuned``, ``ompl:NAME``): the hook
+#: still runs on every call (the tuned file may go, the extra may be missing), but the spec it
+#: vouched for is made once, so such a label costs its peers no more than its hook (fair
+#: comparisons: ``rrt:tuned`` paid ~10 us a call more than ``rrt``; README).
+_CHECKED_SPECS: dict = {}
 
 
 def check_planner(name: str, where: str = "--planners") -> str:
@@ -312,13 +323,26 @@ def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, ma
 
 
 def _tuned_rrt(where: str) -> dict[str, float]:
-    """``step_deg`` and ``goal_bias`` of the shipped ``rrt.toml``, or one InputError."""
-    tuned = tuned_params("rrt")
+    """``step_deg`` and ``goal_bias`` of the shipped ``rrt.toml``, or one InputError.
+
+    The file is stat-ed on every call (:func:`~xfuzzy_rrt.planners.tuned.tuned_record`: an
+    edit is seen at once); its checked parameters are kept per parsed record, so an unchanged
+    file costs one stat, not a copy and a check as well (read-only: callers unpack it)."""
+    record = tuned_record("rrt")
+    if record is not None and record is _TUNED_SEEN[0]:
+        return _TUNED_SEEN[1]
+    tuned = None if record is None else record["params"]
     if tuned is None or set(tuned) != {"step_deg", "goal_bias"}:
         raise InputError(where, f"{RRT_TUNED} needs the tuned file {tuned_path('rrt')} with "
                          "step_deg and goal_bias (make it with 'xfuzzy-rrt tune rrt --out "
                          "FILE')")
+    tuned = dict(tuned)
+    _TUNED_SEEN[:] = [record, tuned]
     return tuned
+
+
+#: The last tuned record :func:`_tuned_rrt` accepted and its parameters.
+_TUNED_SEEN: list = [None, None]
 
 
 def _same_rulebook(rulebook, directory: Path) -> bool:

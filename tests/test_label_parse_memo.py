@@ -63,3 +63,18 @@ def test_rrt_tuned_checks_its_file_on_every_call_though_its_label_is_parsed_once
     for _ in range(2):
         with pytest.raises(InputError, match="needs the tuned file"):
             parse_planner("rrt:tuned")
+
+
+def test_a_plan_with_rrt_tuned_reads_its_tuned_file_once(monkeypatch):
+    from xfuzzy_rrt.planners import api, tuned
+
+    scenario = load_scenario(DEMO)
+    plan_scenario(scenario, "rrt:tuned", seed=1, max_iter=300)  # the label accepted once
+    calls = []
+    real = tuned.tuned_record
+    monkeypatch.setattr(api, "tuned_record", lambda label: calls.append(label) or real(label))
+    for seed in range(3):
+        plan_scenario(scenario, "rrt:tuned", seed=seed, max_iter=300)
+    assert calls == ["rrt"] * 3  # one look-up (one stat) a call, like the default's rulebook
+    parse_planner("rrt:tuned")  # parsing alone still checks the file
+    assert len(calls) == 4

@@ -153,14 +153,16 @@ def rulebook_dir_of(arg: str, where: str, prefix: str = FUZZY_PREFIX) -> Path:
     return path
 
 
-def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
+def parse_planner(name: str, where: str = "--planners", recheck: bool = True) -> PlannerSpec:
     """Validate a planner label fully, before any run: raises one InputError naming ``where``.
 
     The label's form is looked up in the planner registry (:mod:`xfuzzy_rrt.planners.registry`),
     whose ``parse`` hook checks the rest: for ``ompl:NAME`` this imports OMPL, so a missing
     extra or an unknown OMPL planner fails here with the same line it would give when planning;
     for ``fuzzy-rrt:NAME`` the rulebook directory must exist (loading it, which validates every
-    rule, is the caller's next step).
+    rule, is the caller's next step). ``recheck=False`` (:func:`plan_scenario`): a label
+    accepted before whose plan hook repeats the parse hook's checks (``plan_rechecks``) is not
+    checked twice in one call.
     """
     entry = _registry.lookup(name)
     if entry is None:
@@ -174,7 +176,8 @@ def parse_planner(name: str, where: str = "--planners") -> PlannerSpec:
     arg = name[len(entry.label):] if entry.is_prefix else None
     spec = _CHECKED_SPECS.get(name)
     if spec is not None and spec.planner is entry:
-        entry.parse_fn(name, arg, where)  # the hook checks again: its verdict may change
+        if recheck or not entry.plan_rechecks:
+            entry.parse_fn(name, arg, where)  # the hook checks again: its verdict may change
         return spec
     key = (name, os.environ.get(RULEBOOKS_ENV))  # a shipped name's folder follows the variable
     spec = _PARSED_SPECS.get(key)
@@ -238,7 +241,7 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     look-up, no chain of names.
     """
     check_seed(seed)
-    spec = parse_planner(planner, "--planner")
+    spec = parse_planner(planner, "--planner", recheck=False)
     entry = spec.planner
     if trace and not entry.traces:
         raise InputError("--trace", "traces record fuzzy decisions; use --planner "

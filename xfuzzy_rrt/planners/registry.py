@@ -64,6 +64,9 @@ class Planner:
     - ``fits``: for a rulebook planner, ``fits(rulebook, scenario)`` raising one InputError
       when the rulebook cannot drive the problem (checked by ``bench`` before any run).
     - ``help``: its words in ``plan --planner``'s help (``None``: not listed there).
+    - ``plan_rechecks``: its ``plan`` repeats every check of its ``parse``, with the same one
+      line, so ``plan_scenario`` runs only the plan's once the label was accepted (``rrt:tuned``
+      reads its tuned file once a call, as the default reads its rulebook's stamps once).
     """
 
     label: str
@@ -78,6 +81,7 @@ class Planner:
     core: Callable[..., Any] | str | None = None
     fits: Callable[..., Any] | str | None = None
     help: str | None = field(default=None, compare=False)
+    plan_rechecks: bool = False
 
     def __post_init__(self) -> None:
         if self.arg is None and self.label.endswith(":"):
@@ -202,6 +206,7 @@ register(Planner(
     takes_rulebook=True, traces=True, params="fuzzy-rrt", core=_CORE_CONNECT,
     fits=_FITS_CONNECT))
 register(Planner("rrt:tuned", "rrt", f"{_API}:plan_rrt_label", parse=f"{_API}:parse_tuned",
+                  plan_rechecks=True,
                  params="rrt"))
 register(Planner(
     "fuzzy-rrt:", "fuzzy-rrt", f"{_API}:plan_rulebook_label", arg="RULEBOOK",

@@ -287,6 +287,15 @@ def segment_segment_dist(ax, ay, bx, by, cx, cy, dx, dy):
 @nb.njit(cache=True, nogil=True, _nrt=False)
 def link_segments_into(P, q_deg, seg):
     """Every link of every arm as a segment ``seg[k] = (ax, ay, bx, by)`` (metres)."""
+    _segments_into(P, q_deg, seg, False)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _segments_into(P, q_deg, seg, obstacles_too):
+    """Write every link's segment to ``seg``; with ``obstacles_too``, also return the smallest
+    link-capsule to obstacle distance (:func:`_obstacle_clearance`'s arithmetic) from the same
+    forward-kinematics pass (``inf`` otherwise)."""
+    best = np.inf
     for a in range(P.arm_first.shape[0] - 1):
         x = P.bases[a, 0]
         y = P.bases[a, 1]
@@ -297,8 +306,11 @@ def link_segments_into(P, q_deg, seg):
             seg[k, 1] = y
             seg[k, 2] = nx
             seg[k, 3] = ny
+            if obstacles_too:
+                best = min(best, _link_clearance(x, y, nx, ny, P.radii[a], P.obstacles))
             x = nx
             y = ny
+    return best
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
@@ -423,21 +435,7 @@ def _clearance_with_pairs(P, q_deg, seg):
     gives), and the link pairs (:func:`_pair_clearance`) read them. Why:
     the two passes each computed every joint's sine and cosine, a third of a node check's time
     at 5-7 joints. Same value bit for bit (the same distances, combined by the same ``min``s)."""
-    best = np.inf
-    for a in range(P.arm_first.shape[0] - 1):
-        x = P.bases[a, 0]
-        y = P.bases[a, 1]
-        theta = 0.0
-        for k in range(P.arm_first[a], P.arm_first[a + 1]):
-            nx, ny, theta = fk_step(x, y, theta, P.links[k], q_deg[k])
-            seg[k, 0] = x
-            seg[k, 1] = y
-            seg[k, 2] = nx
-            seg[k, 3] = ny
-            best = min(best, _link_clearance(x, y, nx, ny, P.radii[a], P.obstacles))
-            x = nx
-            y = ny
-    return min(best, _pair_clearance(P, seg))
+    return min(_segments_into(P, q_deg, seg, True), _pair_clearance(P, seg))
 
 
 @nb.njit(cache=True, nogil=True, inline="always")

@@ -101,10 +101,19 @@ class Worker:
 
 
 def old_tree(commit: str) -> Path:
-    path = Path(f"/tmp/old{commit}")
+    """A worktree of ``commit`` under /tmp, named by its hash (a name such as ``HEAD`` moves, so
+    a checkout made under it earlier would be a stale one), made when missing."""
+    full = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--verify",
+                           f"{commit}^{{commit}}"],
+                          check=True, capture_output=True, text=True).stdout.strip()
+    path = Path(f"/tmp/old{full[:12]}")
     if not (path / "xfuzzy_rrt").is_dir():
-        subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(path), commit],
+        subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(path), full],
                        check=True, stdout=subprocess.DEVNULL)
+    head = subprocess.run(["git", "-C", str(path), "rev-parse", "HEAD"], check=True,
+                          capture_output=True, text=True).stdout.strip()
+    if head != full:
+        raise SystemExit(f"error: {path} holds {head[:12]}, not {commit} ({full[:12]})")
     return path
 
 

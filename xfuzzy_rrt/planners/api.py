@@ -206,7 +206,7 @@ _PARSED_SPECS: dict = {}
 #: The spec of each label whose hook names no rulebook (``rrt:tuned``, ``ompl:NAME``): the hook
 #: still runs on every call (the tuned file may go, the extra may be missing), but the spec it
 #: vouched for is made once, so such a label costs its peers no more than its hook (fair
-#: comparisons: ``rrt:tuned`` paid ~10 us a call more than ``rrt``; README).
+#: comparisons: ``rrt:tuned`` paid ~5 us a call more than the default; README).
 _CHECKED_SPECS: dict = {}
 
 
@@ -328,24 +328,16 @@ def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, ma
 def _tuned_rrt(where: str) -> dict[str, float]:
     """``step_deg`` and ``goal_bias`` of the shipped ``rrt.toml``, or one InputError.
 
-    The file is stat-ed on every call (:func:`~xfuzzy_rrt.planners.tuned.tuned_record`: an
-    edit is seen at once); its checked parameters are kept per parsed record, so an unchanged
-    file costs one stat, not a copy and a check as well (read-only: callers unpack it)."""
+    The file is stat-ed on every call and parsed only when it changed
+    (:func:`~xfuzzy_rrt.planners.tuned.tuned_record`); its parameters are returned as parsed,
+    not copied (read-only: callers unpack them)."""
     record = tuned_record("rrt")
-    if record is not None and record is _TUNED_SEEN[0]:
-        return _TUNED_SEEN[1]
     tuned = None if record is None else record["params"]
     if tuned is None or set(tuned) != {"step_deg", "goal_bias"}:
         raise InputError(where, f"{RRT_TUNED} needs the tuned file {tuned_path('rrt')} with "
                          "step_deg and goal_bias (make it with 'xfuzzy-rrt tune rrt --out "
                          "FILE')")
-    tuned = dict(tuned)
-    _TUNED_SEEN[:] = [record, tuned]
     return tuned
-
-
-#: The last tuned record :func:`_tuned_rrt` accepted and its parameters.
-_TUNED_SEEN: list = [None, None]
 
 
 def _same_rulebook(rulebook, directory: Path) -> bool:

@@ -37,13 +37,14 @@ CALLS = ("default", "floor", "rrt:tuned")
 def measure(scenarios, seeds, max_iter=10_000):
     """Per problem ``(tuned call s, floor call s, default call s)``, medians over seeds (a failed
     run counts as infinitely slow)."""
-    from xfuzzy_rrt.planners.api import load_shipped_default, plan_scenario
+    from xfuzzy_rrt.planners.api import load_shipped_default, load_tuned_rrt, plan_scenario
 
     default = load_shipped_default()
+    tuned = load_tuned_rrt()  # read once, as the default's rulebooks are (evaluate does both)
 
     def call(sc, which, seed):
         if which == "rrt:tuned":
-            args = ("rrt:tuned", None, max_iter)
+            args = ("rrt:tuned", tuned, max_iter)
         else:
             args = ("fuzzy-rrt", default, 1 if which == "floor" else max_iter)
         t0 = time.perf_counter()

@@ -109,7 +109,11 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     ``ompl:NAME``); ``label`` names it in the tables, ``planner_used``/``rulebook`` in the runs
     say what ran.
     """
-    entries = [("rrt", "rrt", None), *planners]
+    from xfuzzy_rrt.planners.api import preloaded
+
+    # rrt:tuned's settings read once, as the default's rulebooks are (api.TunedRRT)
+    entries = [("rrt", "rrt", None), *((label, planner, preloaded(planner, rb))
+                                       for label, planner, rb in planners)]
     rows = []
     total = len(scenarios) * len(entries)
     done = 0

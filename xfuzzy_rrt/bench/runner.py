@@ -204,11 +204,17 @@ def job_rulebooks(planners: list[str], rulebooks: dict[str, Any], rulebook=None)
     """Label -> what :func:`plan_scenario` gets as ``rulebook`` in that label's jobs: the loaded
     rulebook, or for plain ``fuzzy-rrt`` without a ``rulebook`` the shipped default with both
     its rulebooks loaded once (:class:`~xfuzzy_rrt.planners.api.ShippedDefault`), so that each
-    problem runs its own default and no run re-reads a rulebook."""
+    problem runs its own default and no run re-reads a rulebook; ``rrt:tuned`` gets its tuned
+    settings read once (:class:`~xfuzzy_rrt.planners.api.TunedRRT`), so that no run of the
+    peer re-reads its file either."""
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
-    from xfuzzy_rrt.planners.api import ANY_ARM_PLANNER, ShippedDefault, default_rulebook_dir
+    from xfuzzy_rrt.planners.api import (ANY_ARM_PLANNER, ShippedDefault, default_rulebook_dir,
+                                         preloaded)
 
     out = dict(rulebooks)
+    for planner in planners:
+        if planner not in out and preloaded(planner, None) is not None:
+            out[planner] = preloaded(planner, None)
     if "fuzzy-rrt" in planners and rulebook is None and "fuzzy-rrt" in rulebooks:
         out["fuzzy-rrt"] = ShippedDefault(rulebooks["fuzzy-rrt"],
                                           load_rulebook(default_rulebook_dir(ANY_ARM_PLANNER)))

@@ -116,6 +116,40 @@ class ShippedDefault:
         return ANY_ARM_PLANNER, self.any_arm
 
 
+@dataclass(frozen=True)
+class TunedRRT:
+    """The settings of ``rrt:tuned`` read once (:func:`load_tuned_rrt`), for callers that plan
+    many problems (evaluate, bench): passed as ``plan_scenario(..., "rrt:tuned",
+    rulebook=...)``, a call does not look at the tuned file again.
+
+    Why: those tools load the default's rulebooks once (:class:`ShippedDefault`), so its calls
+    check no file, while ``rrt:tuned`` stat-ed its file on every call (one ``os.stat``, ~3 us
+    warm and tens of microseconds after a long run has evicted the caches): a handicap of the
+    peer, not of the planner. A library user of a tuned RRT passes its two numbers; so do these
+    tools now. Plain ``plan_scenario(..., "rrt:tuned")`` still reads the file (a removed or
+    broken file is refused at once)."""
+
+    step_deg: float
+    goal_bias: float
+
+
+def load_tuned_rrt(where: str = "--planner") -> TunedRRT:
+    """``rrt:tuned``'s settings as the shipped tuned file gives them now (one InputError
+    naming ``where`` when the file is missing or broken)."""
+    tuned = _tuned_rrt(where)
+    return TunedRRT(float(tuned["step_deg"]), float(tuned["goal_bias"]))
+
+
+def preloaded(planner: str, rulebook: Any) -> Any:
+    """What a caller that plans ``planner`` many times passes as ``rulebook``: ``rrt:tuned``'s
+    settings read once (:class:`TunedRRT`) when it passes nothing, else ``rulebook`` as given
+    (the shipped default of plain ``fuzzy-rrt`` is loaded by its callers:
+    :func:`load_shipped_default`)."""
+    if planner == RRT_TUNED and rulebook is None:
+        return load_tuned_rrt()
+    return rulebook
+
+
 def load_shipped_default() -> ShippedDefault:
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 
@@ -273,6 +307,11 @@ def plan_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max
                    goal_bias, trace, clearance_m, max_time_s) -> PlanResult:
     """``rrt`` with ``step_deg``/``goal_bias``; ``rrt:tuned`` with the tuned file's."""
     if spec.label == RRT_TUNED:  # the label fixes the settings: the tuned file's
+        if type(rulebook) is TunedRRT:  # read once by the caller (evaluate, bench)
+            return plan_rrt_as(RRT_TUNED, _TUNED_PARAMS, scenario, seed=seed,
+                               max_iter=max_iter, clearance_m=clearance_m,
+                               max_time_s=max_time_s, step_deg=rulebook.step_deg,
+                               goal_bias=rulebook.goal_bias)
         tuned = _tuned_rrt("--planner")
         return plan_rrt_as(RRT_TUNED, _TUNED_PARAMS, scenario, seed=seed, max_iter=max_iter,
                            clearance_m=clearance_m, max_time_s=max_time_s, **tuned)
@@ -290,6 +329,9 @@ def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed
     the caller names, else the shipped default (:func:`shipped_default`'s rule for plain
     ``fuzzy-rrt``); the kind that runs calls its registration's ``core``."""
     kind = spec.kind
+    if type(rulebook) is TunedRRT:
+        raise InputError("--rulebook", f"tuned RRT settings are not a rulebook ({spec.label} "
+                         "takes a rulebook)")
     default = rulebook if isinstance(rulebook, ShippedDefault) else None
     if default is not None:  # the shipped default, preloaded: the same as rulebook=None
         rulebook = None

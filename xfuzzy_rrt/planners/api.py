@@ -351,11 +351,10 @@ def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed
     elif rulebook is None and default is not None:
         rulebook = default.any_arm
     core = (spec.planner if kind == spec.kind else _registry.lookup(kind)).core_fn
-    result = core(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter, trace=trace,
-                  clearance_m=clearance_m, max_time_s=max_time_s)
-    if result.planner == spec.label and result.planner_used == kind:  # nothing to relabel
-        return result
-    return replace_result(result, planner=spec.label, planner_used=kind)
+    # the core names its result with the label (planner_used: its own kind), as rrt:tuned's
+    # does: no finished result is copied to relabel it
+    return core(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter, trace=trace,
+                clearance_m=clearance_m, max_time_s=max_time_s, label=spec.label)
 
 
 def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter, step_deg,

@@ -74,13 +74,13 @@ import numpy as np
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.semantics import length_scale
-from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, node_clearance
 from xfuzzy_rrt.planners.goal_frame import (
     REJECT_DECAY,
     _joint_dist,
+    infer_first,
     problem_lever,
     sample_goal_frame,
 )
@@ -99,7 +99,7 @@ from xfuzzy_rrt.planners.rng import seed_state
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
-from xfuzzy_rrt.planners.prepared import idle_trace, pooled_tree, scenario_arrays
+from xfuzzy_rrt.planners.prepared import idle_trace, pooled_tree_pair, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
 from xfuzzy_rrt.planners.trace_record import TraceArrays
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
@@ -155,15 +155,14 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step
         P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record, TR, grown,
         connect_nodes, counts, np.empty(4, dtype=np.uint64), np.empty(4, dtype=np.float64),
         np.empty(n_out, dtype=np.float64), np.empty(n_out, dtype=np.float64),
-        np.empty((n_out, MAX_FIRED), dtype=np.int32),
-        np.empty((n_out, MAX_FIRED), dtype=np.float64), np.empty(2 * dof, dtype=np.float64),
+        np.empty(2 * dof, dtype=np.float64),
         np.empty((7, dof), dtype=np.float64), np.zeros(2, dtype=np.int64),
         np.zeros(2, dtype=np.float64))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
 def _connect_loop(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
-                  TR, grown, connect_nodes, counts, state, x, y, ys, dummy_rule, dummy_w, box,
+                  TR, grown, connect_nodes, counts, state, x, y, ys, box,
                   vecs, current, reject):
     """:func:`connect_kernel`'s loop, given its scratch buffers (``vecs``: one row each for
     the sample, ``e``, the near and new configurations of both trees and the target)."""
@@ -229,15 +228,16 @@ def _connect_loop(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step,
         x[3] = reject[g]
         if record:
             infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
-        else:
-            infer(knots, consts, x, y, dummy_rule, dummy_w, False)
-        ys[0] = y[0]
-        ys[1] = y[1]
-        for k in range(2, n_out):  # lengths back to joint-space degrees
-            ys[k] = y[k] * scale
+            ys[0] = y[0]
+            ys[1] = y[1]
+            for k in range(2, n_out):  # lengths back to joint-space degrees
+                ys[k] = y[k] * scale
+        else:  # the other outputs when the draws need them (sample_goal_frame)
+            infer_first(knots, consts, x, ys, scale)
         step = max(ys[5], min_step)
         # 3. sample in the box pointing at the target
-        target_sampled = sample_goal_frame(q, target, d_target, ys, limits, state, sample, box, e)
+        target_sampled = sample_goal_frame(q, target, d_target, ys, limits, state, sample, box,
+                                           e, not record, knots, consts, x, scale)
         # 4. grow
         near = nearest(G, sample)
         current[g] = near
@@ -438,13 +438,13 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
                            max_iter: int = 10_000, trace: bool = False,
                            min_step_deg: float | None = None, margin: float | None = None,
                            clearance_m: float | None = None,
-                           max_time_s: float | None = None) -> PlanResult:
+                           max_time_s: float | None = None, label: str = PLANNER) -> PlanResult:
     """Plan with Fuzzy-RRT-Connect (see the module docstring).
 
     ``rulebook``: a loaded goal-frame or goal-frame-any rulebook, a rulebook directory, or
     ``None`` for the shipped ``goal-frame-any`` (any arm); a goal-frame rulebook's DOF must be
-    the problem's total number of joints. Other
-    arguments as for :func:`~xfuzzy_rrt.planners.fuzzy_rrt.plan_fuzzy_rrt`.
+    the problem's total number of joints. Other arguments (``label``: the result's
+    ``planner``) as for :func:`~xfuzzy_rrt.planners.fuzzy_rrt.plan_fuzzy_rrt`.
     """
     if trace or max_time_s is not None:
         setup = _prepare(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -455,9 +455,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
     work = new_work_counter()  # one count for both directions
     problem = (*setup.forward_head, work)
-    cap = tree_capacity(max_iter)
-    arena_a = pooled_tree(cap, a.limits_deg, slot=0)
-    arena_b = pooled_tree(cap, a.limits_deg, slot=1)
+    arena_a, arena_b = pooled_tree_pair(tree_capacity(max_iter), a.limits_deg)
     ta, tb = arena_a.tree, arena_b.tree
     if trace:
         buffers = make_trace(max_iter, a.dof, knots.shape[0], 1)
@@ -467,27 +465,29 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     else:
         tr, grown, connect_nodes = setup.idle
     counts = np.zeros(1, dtype=np.int64)
-    args = (problem, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout, int(seed))
-    tail = (knots, consts, scale, min_step)
-
-    def run(iters, stop):
-        return connect_entry(*args, int(iters), *tail, stop, bool(trace), tr, grown,
-                             connect_nodes, counts)
-
-    recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
-                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
+    block_a, layout_a, block_b, layout_b = (arena_a.block, arena_a.layout, arena_b.block,
+                                            arena_b.layout)
+    record = bool(trace)
     if max_time_s is None:
         t0 = time.perf_counter()
-        ok, iterations, last_a, last_b = run(max_iter, NEVER_STOPPED)
+        ok, iterations, last_a, last_b = connect_entry(
+            problem, block_a, layout_a, block_b, layout_b, int(seed), max_iter, knots, consts,
+            scale, min_step, NEVER_STOPPED, record, tr, grown, connect_nodes, counts)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        run(0, np.zeros(1, dtype=np.int64))  # the next run empties the trees again
+        connect_entry(problem, block_a, layout_a, block_b, layout_b, int(seed), 0, knots, consts,
+                      scale, min_step, np.zeros(1, dtype=np.int64), record, tr, grown,
+                      connect_nodes, counts)  # the next run empties the trees again
         work[0] = 0
         counts[0] = 0
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
-            ok, iterations, last_a, last_b = run(max_iter, flag.array)
+            ok, iterations, last_a, last_b = connect_entry(
+                problem, block_a, layout_a, block_b, layout_b, int(seed), max_iter, knots,
+                consts, scale, min_step, flag.array, record, tr, grown, connect_nodes, counts)
             wall = time.perf_counter() - t0
+    recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
+                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
     ok = bool(ok)
     na, nb_ = int(ta.meta[0]), int(tb.meta[0])
     nodes, parent, path, cost, within, same = finish_connect_run(
@@ -500,7 +500,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         recorded["max_time_s"] = float(setup.params["max_time_s"])
         recorded["stopped_by"] = stopped_by(ok, int(iterations), max_iter, flag)
     result = certified_result(
-        a, margin, ok, scenario=scenario.name, planner=PLANNER, planner_used=PLANNER,
+        a, margin, ok, scenario=scenario.name, planner=label, planner_used=PLANNER,
         seed=int(seed),
         iterations=int(iterations), nodes=na + nb_,
         cost_deg=cost if ok else None, wall_s=wall, path_deg=path,

@@ -363,7 +363,7 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,
                    trace: bool = False, min_step_deg: float = MIN_STEP_DEG,
                    margin: float | None = None, clearance_m: float | None = None,
-                   max_time_s: float | None = None) -> PlanResult:
+                   max_time_s: float | None = None, label: str = "fuzzy-rrt") -> PlanResult:
     """Plan with Fuzzy-RRT.
 
     ``rulebook`` is a loaded :class:`~xfuzzy_rrt.fuzzy.rulebook.Rulebook`, a rulebook directory,
@@ -371,7 +371,9 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     With ``trace=True`` the result carries a per-iteration DataFrame (see
     :mod:`xfuzzy_rrt.planners.trace`). Same inputs and seed, same result (unless the
     wall-clock budget ``max_time_s`` ends the run). ``clearance_m``/``margin`` as for
-    :func:`~xfuzzy_rrt.planners.rrt.plan_rrt`.
+    :func:`~xfuzzy_rrt.planners.rrt.plan_rrt`. ``label``: the result's ``planner`` (the label
+    the caller planned with, e.g. ``fuzzy-rrt:goal-frame``; ``planner_used`` stays
+    ``fuzzy-rrt``), so that no finished result is copied to relabel it.
     """
     if trace or max_time_s is not None:
         setup = _prepare(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -412,7 +414,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     # certifies the path (found -> success)
     result = certified_result(
         a, margin, bool(ok), edges_certified=True, within_limits=within,
-        scenario=scenario.name, planner="fuzzy-rrt", planner_used="fuzzy-rrt", seed=int(seed),
+        scenario=scenario.name, planner=label, planner_used="fuzzy-rrt", seed=int(seed),
         iterations=int(iterations), nodes=n, cost_deg=cost if ok else None, wall_s=wall,
         path_deg=path, tree_nodes_deg=nodes, tree_parent=parents,
         work=int(problem[-1][0] + tree.meta[NN_VISITS]),

@@ -21,7 +21,8 @@ import numpy as np
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace
 from xfuzzy_rrt.planners.tree_arena import TreeArena, make_tree_arena
 
-#: Trees kept per thread (each up to ``capacity x dof`` floats: 0.6 MB at 10,000 x 7).
+#: Trees (or pairs of trees) kept per thread (each up to ``capacity x dof`` floats: 0.6 MB at
+#: 10,000 x 7).
 _TREES_PER_THREAD = 4
 _local = threading.local()
 _arrays: dict[int, tuple] = {}
@@ -57,6 +58,25 @@ def pooled_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeAre
     hit = pool.get(key)
     if hit is None:
         hit = pool[key] = make_tree_arena(int(capacity), limits)
+        while len(pool) > _TREES_PER_THREAD:
+            pool.popitem(last=False)
+        return hit
+    pool.move_to_end(key)
+    return hit
+
+
+def pooled_tree_pair(capacity: int, limits_deg: np.ndarray) -> tuple[TreeArena, TreeArena]:
+    """Two trees as :func:`pooled_tree` gives them (Fuzzy-RRT-Connect's start and goal trees),
+    found with one look-up: the same two per thread and settings, kept as one entry."""
+    limits = np.asarray(limits_deg, dtype=np.float64)
+    key = (int(capacity), limits.shape, limits.tobytes(), "pair")
+    pool = getattr(_local, "trees", None)
+    if pool is None:
+        pool = _local.trees = OrderedDict()
+    hit = pool.get(key)
+    if hit is None:
+        hit = pool[key] = (make_tree_arena(int(capacity), limits),
+                           make_tree_arena(int(capacity), limits))
         while len(pool) > _TREES_PER_THREAD:
             pool.popitem(last=False)
         return hit

@@ -60,7 +60,8 @@ class Planner:
     - ``first_solution``: every run stops at its first solution (so the time to it is the
       planner's ``wall_s``); otherwise the result's ``stopped_by`` says.
     - ``core``: for a rulebook planner, its own function ``core(scenario, rulebook, seed=...,
-      max_iter=..., trace=..., clearance_m=..., max_time_s=...)`` (what ``explain`` replays).
+      max_iter=..., trace=..., clearance_m=..., max_time_s=..., label=...)`` (what ``explain``
+      replays); ``label`` names its result's ``planner``, ``planner_used`` is its own kind.
     - ``fits``: for a rulebook planner, ``fits(rulebook, scenario)`` raising one InputError
       when the rulebook cannot drive the problem (checked by ``bench`` before any run).
     - ``help``: its words in ``plan --planner``'s help (``None``: not listed there).

@@ -79,14 +79,6 @@ def _combine(c, r, a0, b0, a1, b1, a2, b2, a3, b3):
     return num / den
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
-def infer_output(knots, consts, f, x):
-    """Output ``f`` alone at input ``x``: bit for bit what :func:`infer` writes to ``out[f]``
-    (the same arithmetic), for a planner that needs only some outputs in an iteration
-    (:func:`~xfuzzy_rrt.planners.goal_frame.sample_goal_frame`)."""
-    return _infer_fis(knots, consts, f, x[0], x[1], x[2], x[3])
-
-
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def infer(knots, consts, x, out, fired_rule, fired_w, record):
     """Evaluate every FIS at input ``x`` (float64[4], inputs order) into ``out``

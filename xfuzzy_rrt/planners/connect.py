@@ -74,13 +74,13 @@ import numpy as np
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.semantics import length_scale
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, node_clearance
 from xfuzzy_rrt.planners.goal_frame import (
     REJECT_DECAY,
     _joint_dist,
-    infer_first,
     problem_lever,
     sample_goal_frame,
 )
@@ -155,14 +155,15 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step
         P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record, TR, grown,
         connect_nodes, counts, np.empty(4, dtype=np.uint64), np.empty(4, dtype=np.float64),
         np.empty(n_out, dtype=np.float64), np.empty(n_out, dtype=np.float64),
-        np.empty(2 * dof, dtype=np.float64),
+        np.empty((n_out, MAX_FIRED), dtype=np.int32),
+        np.empty((n_out, MAX_FIRED), dtype=np.float64), np.empty(2 * dof, dtype=np.float64),
         np.empty((7, dof), dtype=np.float64), np.zeros(2, dtype=np.int64),
         np.zeros(2, dtype=np.float64))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
 def _connect_loop(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
-                  TR, grown, connect_nodes, counts, state, x, y, ys, box,
+                  TR, grown, connect_nodes, counts, state, x, y, ys, dummy_rule, dummy_w, box,
                   vecs, current, reject):
     """:func:`connect_kernel`'s loop, given its scratch buffers (``vecs``: one row each for
     the sample, ``e``, the near and new configurations of both trees and the target)."""
@@ -228,16 +229,15 @@ def _connect_loop(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step,
         x[3] = reject[g]
         if record:
             infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
-            ys[0] = y[0]
-            ys[1] = y[1]
-            for k in range(2, n_out):  # lengths back to joint-space degrees
-                ys[k] = y[k] * scale
-        else:  # the other outputs when the draws need them (sample_goal_frame)
-            infer_first(knots, consts, x, ys, scale)
+        else:
+            infer(knots, consts, x, y, dummy_rule, dummy_w, False)
+        ys[0] = y[0]
+        ys[1] = y[1]
+        for k in range(2, n_out):  # lengths back to joint-space degrees
+            ys[k] = y[k] * scale
         step = max(ys[5], min_step)
         # 3. sample in the box pointing at the target
-        target_sampled = sample_goal_frame(q, target, d_target, ys, limits, state, sample, box,
-                                           e, not record, knots, consts, x, scale)
+        target_sampled = sample_goal_frame(q, target, d_target, ys, limits, state, sample, box, e)
         # 4. grow
         near = nearest(G, sample)
         current[g] = near

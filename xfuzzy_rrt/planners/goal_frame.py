@@ -44,7 +44,8 @@ import math
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.fuzzy.engine import infer, infer_output
+from xfuzzy_rrt.fuzzy.engine import infer
+from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.planners.extend import extend, node_clearance
 from xfuzzy_rrt.planners.result import ACCEPTED, EDGE_BLOCKED, GOAL_REACHED, NODE_IN_COLLISION
 from xfuzzy_rrt.planners.rng import seed_state, uniform
@@ -98,20 +99,7 @@ def _joint_dist(a, b):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def infer_first(knots, consts, x, y, scale):
-    """The outputs every iteration reads, before it samples: ``y[0]`` (goal bias) and ``y[5]``
-    (step, times ``scale``); :func:`sample_goal_frame` with ``lazy`` infers the others only
-    when its draws need them. Why: at 3-7 joints the shipped rulebook samples uniformly in
-    ~63 % of iterations, where the box outputs ``y[2:5]`` are never read, and an inference of
-    six systems (~0.15 us) is a sixth of a 3-joint iteration. The values are the ones
-    :func:`~xfuzzy_rrt.fuzzy.engine.infer` gives (same arithmetic), so runs are unchanged."""
-    y[0] = infer_output(knots, consts, 0, x)
-    y[5] = infer_output(knots, consts, 5, x) * scale
-
-
-@nb.njit(cache=True, nogil=True, inline="always")
-def sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e, lazy, knots, consts, x,
-                      scale):
+def sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e):
     """Step 3 of the module docstring: draw the sample of one goal-frame iteration.
 
     ``q`` is the current node, ``goal`` the configuration the box points at (the goal here;
@@ -119,17 +107,9 @@ def sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e, lazy, k
     distance and ``y`` the six outputs. Writes ``sample``, the traced bounding ``box`` and the
     direction ``e``; returns whether ``goal`` itself was sampled. Shared so that both planners
     draw the same random numbers in the same order for the same outputs.
-
-    ``lazy``: only ``y[0]`` and ``y[5]`` are given (:func:`infer_first`); ``y[1]`` is inferred
-    from ``knots``/``consts`` at ``x`` when the goal was not drawn, ``y[2:5]`` (times
-    ``scale``, the lengths' unit) when the sample falls in the box. The draws and values are
-    exactly those of the eager call, so a run does not depend on ``lazy``; traces pass every
-    output (they record them all).
     """
     dof = q.shape[0]
     goal_sampled = uniform(state) < y[0]
-    if not goal_sampled and lazy:
-        y[1] = infer_output(knots, consts, 1, x)
     if goal_sampled:
         for j in range(dof):
             sample[j] = goal[j]
@@ -141,9 +121,6 @@ def sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e, lazy, k
             box[2 * j] = limits[j, 0]
             box[2 * j + 1] = limits[j, 1]
     else:
-        if lazy:
-            for f in range(2, 5):
-                y[f] = infer_output(knots, consts, f, x) * scale
         if d_goal > 0.0:
             for j in range(dof):
                 e[j] = (goal[j] - q[j]) / d_goal
@@ -203,14 +180,15 @@ def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step
     return _goal_frame_loop(
         P, T, seed, max_iter, knots, consts, min_step, stop, record, TR,
         np.empty(4, dtype=np.uint64), np.empty(4, dtype=np.float64),
-        np.empty(n_out, dtype=np.float64), np.empty(2 * dof, dtype=np.float64),
+        np.empty(n_out, dtype=np.float64), np.empty((n_out, MAX_FIRED), dtype=np.int32),
+        np.empty((n_out, MAX_FIRED), dtype=np.float64), np.empty(2 * dof, dtype=np.float64),
         np.empty(dof, dtype=np.float64), np.empty(dof, dtype=np.float64),
         np.empty(dof, dtype=np.float64), np.empty(dof, dtype=np.float64))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
 def _goal_frame_loop(P, T, seed, max_iter, knots, consts, min_step, stop, record, TR, state, x,
-                     y, box, sample, e, q_near, q_new):
+                     y, dummy_rule, dummy_w, box, sample, e, q_near, q_new):
     """:func:`goal_frame_kernel`'s loop, given its scratch buffers."""
     seed_state(seed, state)
     n_out = knots.shape[0]
@@ -245,11 +223,10 @@ def _goal_frame_loop(P, T, seed, max_iter, knots, consts, min_step, stop, record
         x[3] = reject
         if record:
             infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
-        else:  # the other outputs when the draws need them (sample_goal_frame)
-            infer_first(knots, consts, x, y, 1.0)
+        else:
+            infer(knots, consts, x, y, dummy_rule, dummy_w, False)
         step = max(y[5], min_step)
-        goal_sampled = sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e,
-                                         not record, knots, consts, x, 1.0)
+        goal_sampled = sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e)
         from_node = current
         current = nearest(T, sample)
         outcome, new_index = extend(P, T, current, sample, step, q_near, q_new)

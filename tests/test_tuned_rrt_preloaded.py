@@ -1,6 +1,8 @@
 """The tools that plan many problems (evaluate, bench) read ``rrt:tuned``'s settings once, as
 they load the default's rulebooks once, so the peer's time carries no per-call file check the
-default does not carry (planners/api.py, ``TunedRRT``); the plans are the same."""
+default does not carry (planners/api.py, ``TunedRRT``); the plans are the same. And the protocol
+shuffles its call order per seed, so no planner always runs right after another one (whose
+identical kernel would have warmed the caches for it)."""
 
 from pathlib import Path
 
@@ -55,3 +57,30 @@ def test_tuned_settings_given_to_a_fuzzy_planner_are_refused_with_one_line():
     scenario = load_scenario(DEMO)
     with pytest.raises(InputError, match="not a rulebook"):
         plan_scenario(scenario, "fuzzy-rrt", rulebook=load_tuned_rrt(), seed=1, max_iter=50)
+
+
+def test_the_protocol_does_not_call_one_planner_always_right_after_another():
+    from xfuzzy_rrt.bench.protocol import call_order
+
+    orders = [call_order(5, k) for k in range(50)]
+    assert all(sorted(o) == list(range(5)) for o in orders)
+    assert orders == [call_order(5, k) for k in range(50)]  # the same shuffles every run
+    # rrt (entry 0) is followed by rrt:tuned (entry 1) in some seeds, not in all
+    after_rrt = [o[o.index(0) + 1] if o.index(0) < 4 else None for o in orders]
+    assert 0 < after_rrt.count(1) < 25
+
+
+def test_the_protocol_calls_planners_in_the_shuffled_order(monkeypatch):
+    from xfuzzy_rrt.bench import protocol
+
+    calls = []
+    real = protocol._one
+    monkeypatch.setattr(protocol, "_one", lambda sc, planner, *a: calls.append(planner)
+                        or real(sc, planner, *a))
+    scenario = load_scenario(DEMO)
+    entries = [("rrt:tuned", "rrt:tuned", None), ("fuzzy-rrt", "fuzzy-rrt", None)]
+    protocol.run_protocol([scenario], entries, runs=6, max_iter=200)
+    timed = calls[-18:]
+    names = ["rrt", "rrt:tuned", "fuzzy-rrt"]
+    assert [timed[3 * k:3 * k + 3] for k in range(6)] == \
+        [[names[i] for i in protocol.call_order(3, k)] for k in range(6)]

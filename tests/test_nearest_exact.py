@@ -124,3 +124,15 @@ def test_a_plan_counts_its_neighbour_visits_and_a_fresh_tree_starts_at_zero():
     assert T.meta[tr.NN_VISITS] == 1
     again = pooled_tree(100, limits)  # the next plan gets the same tree back, emptied
     assert emptied_tree_in(again.block, again.layout).meta[tr.NN_VISITS] == 0
+
+
+def test_a_plan_that_grows_two_trees_gets_two_distinct_pooled_trees_back_each_time():
+    from xfuzzy_rrt.planners.prepared import pooled_tree, pooled_trees
+
+    limits = _limits(3)
+    a, b = pooled_trees(100, limits, 2)
+    assert a.block is not b.block
+    again = pooled_trees(100, limits, 2)  # one entry, found again
+    assert again[0] is a and again[1] is b
+    single = pooled_tree(100, limits).block
+    assert single is not a.block and single is not b.block

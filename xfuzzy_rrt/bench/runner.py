@@ -213,8 +213,10 @@ def job_rulebooks(planners: list[str], rulebooks: dict[str, Any], rulebook=None)
 
     out = dict(rulebooks)
     for planner in planners:
-        if planner not in out and preloaded(planner, None) is not None:
-            out[planner] = preloaded(planner, None)
+        if planner not in out:
+            given = preloaded(planner, None)
+            if given is not None:
+                out[planner] = given
     if "fuzzy-rrt" in planners and rulebook is None and "fuzzy-rrt" in rulebooks:
         out["fuzzy-rrt"] = ShippedDefault(rulebooks["fuzzy-rrt"],
                                           load_rulebook(default_rulebook_dir(ANY_ARM_PLANNER)))

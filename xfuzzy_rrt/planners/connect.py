@@ -99,7 +99,7 @@ from xfuzzy_rrt.planners.rng import seed_state
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
-from xfuzzy_rrt.planners.prepared import idle_trace, pooled_tree_pair, scenario_arrays
+from xfuzzy_rrt.planners.prepared import idle_trace, pooled_trees, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
 from xfuzzy_rrt.planners.trace_record import TraceArrays
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
@@ -455,7 +455,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
     work = new_work_counter()  # one count for both directions
     problem = (*setup.forward_head, work)
-    arena_a, arena_b = pooled_tree_pair(tree_capacity(max_iter), a.limits_deg)
+    arena_a, arena_b = pooled_trees(tree_capacity(max_iter), a.limits_deg, 2)
     ta, tb = arena_a.tree, arena_b.tree
     if trace:
         buffers = make_trace(max_iter, a.dof, knots.shape[0], 1)
@@ -465,29 +465,27 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     else:
         tr, grown, connect_nodes = setup.idle
     counts = np.zeros(1, dtype=np.int64)
-    block_a, layout_a, block_b, layout_b = (arena_a.block, arena_a.layout, arena_b.block,
-                                            arena_b.layout)
-    record = bool(trace)
+    args = (problem, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout, int(seed))
+    tail = (knots, consts, scale, min_step)
+
+    def run(iters, stop):
+        return connect_entry(*args, int(iters), *tail, stop, bool(trace), tr, grown,
+                             connect_nodes, counts)
+
+    recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
+                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
     if max_time_s is None:
         t0 = time.perf_counter()
-        ok, iterations, last_a, last_b = connect_entry(
-            problem, block_a, layout_a, block_b, layout_b, int(seed), max_iter, knots, consts,
-            scale, min_step, NEVER_STOPPED, record, tr, grown, connect_nodes, counts)
+        ok, iterations, last_a, last_b = run(max_iter, NEVER_STOPPED)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        connect_entry(problem, block_a, layout_a, block_b, layout_b, int(seed), 0, knots, consts,
-                      scale, min_step, np.zeros(1, dtype=np.int64), record, tr, grown,
-                      connect_nodes, counts)  # the next run empties the trees again
+        run(0, np.zeros(1, dtype=np.int64))  # the next run empties the trees again
         work[0] = 0
         counts[0] = 0
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
-            ok, iterations, last_a, last_b = connect_entry(
-                problem, block_a, layout_a, block_b, layout_b, int(seed), max_iter, knots,
-                consts, scale, min_step, flag.array, record, tr, grown, connect_nodes, counts)
+            ok, iterations, last_a, last_b = run(max_iter, flag.array)
             wall = time.perf_counter() - t0
-    recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
-                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
     ok = bool(ok)
     na, nb_ = int(ta.meta[0]), int(tb.meta[0])
     nodes, parent, path, cost, within, same = finish_connect_run(

@@ -44,39 +44,25 @@ def scenario_arrays(scenario):
     return arrays
 
 
-def pooled_tree(capacity: int, limits_deg: np.ndarray, slot: int = 0) -> TreeArena:
+def pooled_tree(capacity: int, limits_deg: np.ndarray) -> TreeArena:
     """A tree for ``capacity`` nodes in ``limits_deg`` in one block (:mod:`.tree_arena`),
     reused within this thread from one plan to the next (a result keeps copies, never the
     tree's arrays), *not* emptied: the compiled entries empty it
-    (:func:`~xfuzzy_rrt.planners.tree_arena.emptied_tree_in`). ``slot`` tells apart trees one
-    plan uses at once (Fuzzy-RRT-Connect's two)."""
+    (:func:`~xfuzzy_rrt.planners.tree_arena.emptied_tree_in`)."""
+    return pooled_trees(capacity, limits_deg, 1)[0]
+
+
+def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[TreeArena, ...]:
+    """``count`` distinct trees as :func:`pooled_tree` gives one (Fuzzy-RRT-Connect's start and
+    goal trees: ``count=2``), kept as one pool entry and found with one look-up."""
     limits = np.asarray(limits_deg, dtype=np.float64)
-    key = (int(capacity), limits.shape, limits.tobytes(), int(slot))
+    key = (int(capacity), limits.shape, limits.tobytes(), int(count))
     pool = getattr(_local, "trees", None)
     if pool is None:
         pool = _local.trees = OrderedDict()
     hit = pool.get(key)
     if hit is None:
-        hit = pool[key] = make_tree_arena(int(capacity), limits)
-        while len(pool) > _TREES_PER_THREAD:
-            pool.popitem(last=False)
-        return hit
-    pool.move_to_end(key)
-    return hit
-
-
-def pooled_tree_pair(capacity: int, limits_deg: np.ndarray) -> tuple[TreeArena, TreeArena]:
-    """Two trees as :func:`pooled_tree` gives them (Fuzzy-RRT-Connect's start and goal trees),
-    found with one look-up: the same two per thread and settings, kept as one entry."""
-    limits = np.asarray(limits_deg, dtype=np.float64)
-    key = (int(capacity), limits.shape, limits.tobytes(), "pair")
-    pool = getattr(_local, "trees", None)
-    if pool is None:
-        pool = _local.trees = OrderedDict()
-    hit = pool.get(key)
-    if hit is None:
-        hit = pool[key] = (make_tree_arena(int(capacity), limits),
-                           make_tree_arena(int(capacity), limits))
+        hit = pool[key] = tuple(make_tree_arena(int(capacity), limits) for _ in range(count))
         while len(pool) > _TREES_PER_THREAD:
             pool.popitem(last=False)
         return hit

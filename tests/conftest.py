@@ -139,15 +139,17 @@ def _warm_rrt_and_fuzzy_rrt() -> None:
     s = _warm_scenario()
     plan_scenario(s, planner="rrt", seed=0, max_iter=20)
     for name in ("goal-frame", "expert"):
-        plan_scenario(s, planner="fuzzy-rrt", rulebook=rulebooks_dir() / name, seed=0,
-                      max_iter=20, trace=True)
+        for trace in (True, False):  # an untraced call is its entry's other specialisation
+            plan_scenario(s, planner="fuzzy-rrt", rulebook=rulebooks_dir() / name, seed=0,
+                          max_iter=20, trace=trace)
 
 
 def _warm_connect_and_certificate() -> None:
     from xfuzzy_rrt.planners.api import plan_scenario
 
     s = _warm_scenario()
-    plan_scenario(s, planner="fuzzy-rrt-connect", seed=0, max_iter=20, trace=True)
+    for trace in (True, False):
+        plan_scenario(s, planner="fuzzy-rrt-connect", seed=0, max_iter=20, trace=trace)
     _warm_training("goal-frame-any")  # its population runs the connect kernel just compiled
     # The certificate and the exact minimum clearance (measured lazily, so no plan above
     # compiled them): tests with a time limit must not pay for their first compile.

@@ -1,7 +1,10 @@
 """Recording a trace never changes what a planner does: a traced run (which records every
 output, the fired rules and the box) plans exactly what the untraced run plans -- same path,
 tree, iterations and work -- for goal-frame Fuzzy-RRT at 2 joints and Fuzzy-RRT-Connect, with
-the DOF-free rulebook whose lengths are scaled at 3 and 5 joints and with two arms."""
+the DOF-free rulebook whose lengths are scaled at 3 and 5 joints and with two arms, and the
+paper's semantics (one fuzzy evaluation per arm). An untraced run's entry makes its own idle
+buffers (``idle_buffers``): they must be ``make_trace``'s one-row buffers, so that both runs
+use one compiled kernel."""
 
 from __future__ import annotations
 
@@ -12,6 +15,7 @@ from conftest import FIXTURES
 from test_ndof_paths_oracle import dual_arm, single_arm
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.api import plan_scenario
+from xfuzzy_rrt.planners.trace_record import idle_buffers, make_trace
 
 CASES = [
     (lambda: load_scenario(FIXTURES / "scenarios" / "two-circles.toml"), "fuzzy-rrt:goal-frame"),
@@ -20,11 +24,12 @@ CASES = [
     (lambda: single_arm(3, 0), "fuzzy-rrt"),
     (lambda: single_arm(5, 1), "fuzzy-rrt"),
     (lambda: dual_arm(3, 0), "fuzzy-rrt"),
+    (lambda: load_scenario(FIXTURES / "scenarios" / "boxes-and-circle.toml"), "fuzzy-rrt:expert"),
 ]
 
 
 @pytest.mark.parametrize("make, label", CASES, ids=["gf-2", "connect-2", "any-3", "any-5",
-                                                     "any-dual"])
+                                                     "any-dual", "paper-2"])
 def test_an_untraced_run_plans_exactly_what_a_traced_run_plans(make, label):
     scenario = make()
     for seed in range(4):
@@ -36,3 +41,16 @@ def test_an_untraced_run_plans_exactly_what_a_traced_run_plans(make, label):
         assert np.array_equal(plain.path_deg, traced.path_deg)
         assert np.array_equal(plain.tree_nodes_deg, traced.tree_nodes_deg)
         assert np.array_equal(plain.tree_parent, traced.tree_parent)
+
+
+@pytest.mark.parametrize("dof, n_out, groups", [(2, 6, 1), (3, 6, 1), (7, 6, 1), (6, 8, 2)])
+def test_idle_buffers_made_in_compiled_code_are_make_traces_one_row_buffers(dof, n_out, groups):
+    made = idle_buffers(dof, n_out, groups)
+    expected = make_trace(1, dof, n_out, groups)
+    assert made._fields == expected._fields
+    for name, got, want in zip(expected._fields, made, expected):
+        assert (got.dtype, got.shape) == (want.dtype, want.shape), name
+        # what numba types an array by (dtype, dimensions, layout, mutability, alignment):
+        # equal, so an untraced run calls the very kernel specialisation a traced run calls
+        assert got.flags.c_contiguous and got.flags.writeable and got.flags.aligned, name
+

@@ -70,8 +70,13 @@ from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_resu
                                          finish_tree_run, replace_result)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
-from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
-from xfuzzy_rrt.planners.prepared import idle_trace, pooled_tree, scenario_arrays
+from xfuzzy_rrt.planners.trace_record import (
+    TraceArrays,
+    idle_buffers,
+    make_trace,
+    record_iteration,
+)
+from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
@@ -271,17 +276,30 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
 def fuzzy_rrt_entry(p, block, layout, seed, max_iter, knots, consts, bounds_mode, min_step,
                     stop, record, tr):
     """:func:`fuzzy_rrt_kernel` with the problem and trace bundles as *plain* tuples and the
-    tree as its arena, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`)."""
-    return fuzzy_rrt_kernel(Problem(*p), emptied_tree_in(block, layout), seed, max_iter, knots,
-                            consts, bounds_mode, min_step, stop, record, TraceArrays(*tr))
+    tree as its arena, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`). ``tr``
+    ``None`` (a run that records nothing, ``record`` false): the idle one-row buffers are made
+    here (:func:`~xfuzzy_rrt.planners.trace_record.idle_buffers`: one per arm), not unboxed."""
+    P = Problem(*p)
+    if tr is None:
+        TR = idle_buffers(P.start.shape[0], knots.shape[0], P.arm_first.shape[0] - 1)
+    else:
+        TR = TraceArrays(*tr)
+    return fuzzy_rrt_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots, consts,
+                            bounds_mode, min_step, stop, record, TR)
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def goal_frame_entry(p, block, layout, seed, max_iter, knots, consts, mode, min_step, stop,
                      record, tr):
-    """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, called as above."""
-    return goal_frame_kernel(Problem(*p), emptied_tree_in(block, layout), seed, max_iter,
-                             knots, consts, mode, min_step, stop, record, TraceArrays(*tr))
+    """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, called as above (one fuzzy
+    evaluation per iteration for all arms: one group of idle buffers)."""
+    P = Problem(*p)
+    if tr is None:
+        TR = idle_buffers(P.start.shape[0], knots.shape[0], 1)
+    else:
+        TR = TraceArrays(*tr)
+    return goal_frame_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots, consts,
+                             mode, min_step, stop, record, TR)
 
 
 def entry_for(mode: int):
@@ -329,7 +347,6 @@ class _Setup(NamedTuple):
     consts: np.ndarray
     groups: int
     problem_head: tuple
-    idle: tuple
 
 
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -345,8 +362,7 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     groups = fis_groups(rb, scenario)
     head = tuple(a.problem(margin))[:-1]  # all but the work counter, fresh per call
     return _Setup(rb, a, margin, int(max_iter), float(min_step_deg), params, entry_for(mode),
-                  mode, knots, consts, groups, head,
-                  tuple(idle_trace(a.dof, knots.shape[0], groups)))
+                  mode, knots, consts, groups, head)
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -385,8 +401,8 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     problem = (*setup.problem_head, new_work_counter())
     arena = pooled_tree(max_iter + 2, a.limits_deg)
     tree, block, layout = arena.tree, arena.block, arena.layout
-    buffers = (tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace
-               else setup.idle)
+    # untraced: no buffers to unbox (the entry makes its idle ones)
+    buffers = tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace else None
     recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
                 "bounds": rb.bounds_mode, "min_step_deg": setup.min_step,
                 "margin_m": float(margin)}

@@ -1,13 +1,13 @@
-"""Set-up a plan call reuses instead of rebuilding: a scenario's arrays, the tree, the idle
-trace buffers.
+"""Set-up a plan call reuses instead of rebuilding: a scenario's arrays and the tree.
 
 Why: on a 2-DOF problem the planner's kernel often runs for 0.1-0.5 ms, and building its inputs
 from scratch (a scenario's arrays from the TOML model, a 10,000-node tree, thirteen trace
 buffers that are never written when not tracing) cost as much again. Everything here is an
 exact stand-in for the fresh object: the arrays are the same numbers, the tree is emptied by
 the compiled entry before every use (:func:`~xfuzzy_rrt.planners.tree_arena.emptied_tree_in`,
-:func:`~xfuzzy_rrt.planners.tree.reset_tree`'s state), the idle trace
-buffers are never touched. Trees are per thread, so concurrent plans never share one.
+:func:`~xfuzzy_rrt.planners.tree.reset_tree`'s state). (The idle trace buffers an untraced run
+takes are made by the compiled entries: :func:`~xfuzzy_rrt.planners.trace_record.idle_buffers`.)
+Trees are per thread, so concurrent plans never share one.
 """
 
 from __future__ import annotations
@@ -18,7 +18,6 @@ from collections import OrderedDict
 
 import numpy as np
 
-from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace
 from xfuzzy_rrt.planners.tree_arena import TreeArena, make_tree_arena
 
 #: Trees (or pairs of trees) kept per thread (each up to ``capacity x dof`` floats: 0.6 MB at
@@ -26,7 +25,6 @@ from xfuzzy_rrt.planners.tree_arena import TreeArena, make_tree_arena
 _TREES_PER_THREAD = 4
 _local = threading.local()
 _arrays: dict[int, tuple] = {}
-_idle_traces: dict[tuple[int, int, int], TraceArrays] = {}
 
 
 def scenario_arrays(scenario):
@@ -69,11 +67,3 @@ def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[Tre
     pool.move_to_end(key)
     return hit
 
-
-def idle_trace(dof: int, n_out: int, groups: int) -> TraceArrays:
-    """The one-row trace buffers a kernel takes but never writes when not recording."""
-    key = (int(dof), int(n_out), int(groups))
-    hit = _idle_traces.get(key)
-    if hit is None:
-        hit = _idle_traces[key] = make_trace(1, dof, n_out, groups)
-    return hit

@@ -362,3 +362,32 @@ def test_a_set_up_goes_with_its_scenario(scenarios, fresh_memo):
     del copy
     gc.collect()
     assert len(setup_memo._memo) == 0
+
+
+def test_a_loaded_rulebook_is_matched_by_identity_and_another_load_gets_its_own_set_up(
+        scenarios, rulebook_copy, fresh_memo):
+    from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect
+
+    root, _hashed = rulebook_copy
+    s = scenarios[0]
+    for plan in (plan_fuzzy_rrt, plan_fuzzy_rrt_connect):
+        rb = rbmod.load_rulebook(root)
+        first = plan(s, rb, seed=3)
+        count = len(setup_memo._memo)
+        assert plan(s, rb, seed=3).iterations == first.iterations
+        assert len(setup_memo._memo) == count  # found again, not rebuilt
+        other = rbmod.load_rulebook(root)  # equal, but another object: checked afresh
+        assert plan(s, other, seed=3).iterations == first.iterations
+        assert len(setup_memo._memo) == count + 1
+
+
+def test_a_results_params_are_its_own_not_the_remembered_set_ups(scenarios, fresh_memo):
+    from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect
+
+    s = scenarios[0]
+    for plan in (plan_fuzzy_rrt, plan_fuzzy_rrt_connect, plan_rrt):
+        first = plan(s, seed=4)
+        expected = dict(first.params)
+        first.params["max_iter"] = -1
+        first.params["added"] = True
+        assert plan(s, seed=4).params == expected

@@ -76,8 +76,10 @@ def default_rulebook_dir(kind: str) -> Path:
 
 
 def is_two_joint_problem(scenario: Scenario) -> bool:
-    """One arm of two joints: the problems the shipped ``goal-frame`` rulebook was made for."""
-    return len(scenario.arms) == 1 and scenario.arms[0].dof == 2
+    """One arm of two joints: the problems the shipped ``goal-frame`` rulebook was made for.
+    (Read from the fields, not ``scenario.arms``, which builds a tuple: this runs in every
+    default plan call.)"""
+    return not scenario.more_arms and len(scenario.arm.links) == 2
 
 
 def shipped_default(scenario: Scenario) -> tuple[str, Path]:

@@ -100,7 +100,7 @@ from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.planners.prepared import pooled_trees, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
+from xfuzzy_rrt.planners.setup_memo import exact, remembered_for_rulebook, rulebook_token
 from xfuzzy_rrt.planners.trace_record import TraceArrays, idle_buffers
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
@@ -416,6 +416,8 @@ class _Setup(NamedTuple):
     consts: np.ndarray
     scale: float
     forward_head: tuple
+    #: the result's ``params`` as far as the set-up fixes them (each call copies it)
+    recorded: dict
 
 
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -429,8 +431,11 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     scale = length_scale(rb.semantics, scenario.dof)
     a = scenario_arrays(scenario)
     # all but the work counter, fresh per call (both directions share it: reversed_problem)
-    return _Setup(rb, a, margin, int(max_iter), float(params["min_step_deg"]), params, knots,
-                  consts, scale, tuple(a.problem(margin))[:-1])
+    min_step = float(params["min_step_deg"])
+    recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
+                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
+    return _Setup(rb, a, margin, int(max_iter), min_step, params, knots, consts, scale,
+                  tuple(a.problem(margin))[:-1], recorded)
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -439,9 +444,9 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
     resolves to the same object (a call without a time budget or a trace)."""
     key = (PLANNER, id(scenario), rulebook_token(rulebook), exact(max_iter),
            exact(min_step_deg), exact(margin), exact(clearance_m))
-    return remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
-                                                      margin, clearance_m, None),
-                      lambda hit: _resolve_rulebook(rulebook) is hit.rb)
+    return remembered_for_rulebook(key, scenario, rulebook, _resolve_rulebook,
+                                   lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
+                                                    margin, clearance_m, None))
 
 
 def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
@@ -481,8 +486,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         return connect_entry(*args, int(iters), *tail, stop, bool(trace), tr, grown,
                              connect_nodes)
 
-    recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
-                "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
+    recorded = dict(setup.recorded)
     if max_time_s is None:
         t0 = time.perf_counter()
         ok, iterations, last_a, last_b, extensions = run(max_iter, NEVER_STOPPED)

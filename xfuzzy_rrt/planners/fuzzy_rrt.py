@@ -77,7 +77,7 @@ from xfuzzy_rrt.planners.trace_record import (
     record_iteration,
 )
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
+from xfuzzy_rrt.planners.setup_memo import exact, remembered_for_rulebook, rulebook_token
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
@@ -347,6 +347,8 @@ class _Setup(NamedTuple):
     consts: np.ndarray
     groups: int
     problem_head: tuple
+    #: the result's ``params`` as far as the set-up fixes them (each call copies it)
+    recorded: dict
 
 
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -361,8 +363,11 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     a = scenario_arrays(scenario)
     groups = fis_groups(rb, scenario)
     head = tuple(a.problem(margin))[:-1]  # all but the work counter, fresh per call
+    recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
+                "bounds": rb.bounds_mode, "min_step_deg": float(min_step_deg),
+                "margin_m": float(margin)}
     return _Setup(rb, a, margin, int(max_iter), float(min_step_deg), params, entry_for(mode),
-                  mode, knots, consts, groups, head)
+                  mode, knots, consts, groups, head, recorded)
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -371,9 +376,9 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
     resolves to the same object (a call without a time budget or a trace)."""
     key = ("fuzzy-rrt", id(scenario), rulebook_token(rulebook), exact(max_iter),
            exact(min_step_deg), exact(margin), exact(clearance_m))
-    return remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
-                                                      margin, clearance_m, None),
-                      lambda hit: _resolve_rulebook(rulebook) is hit.rb)
+    return remembered_for_rulebook(key, scenario, rulebook, _resolve_rulebook,
+                                   lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
+                                                    margin, clearance_m, None))
 
 
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,
@@ -403,9 +408,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     tree, block, layout = arena.tree, arena.block, arena.layout
     # untraced: no buffers to unbox (the entry makes its idle ones)
     buffers = tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace else None
-    recorded = {"max_iter": max_iter, "semantics": rb.semantics.name,
-                "bounds": rb.bounds_mode, "min_step_deg": setup.min_step,
-                "margin_m": float(margin)}
+    recorded = dict(setup.recorded)
     if max_time_s is None:
         t0 = time.perf_counter()
         ok, iterations, last = kernel(problem, block, layout, int(seed), max_iter, knots,

@@ -424,3 +424,52 @@ def test_the_compiled_checks_are_ready_at_import_not_compiled_inside_a_timed_sol
                           timeout=600, cwd=PROJECT)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.split() == ["1", "1"]
+
+
+def test_an_ompl_range_read_once_plans_exactly_as_the_label_alone_and_is_not_read_again(
+        monkeypatch):
+    import xfuzzy_rrt.planners.tuned as tuned
+    from xfuzzy_rrt.planners.api import preloaded
+    from xfuzzy_rrt.planners.ompl_bridge import TunedRange
+
+    s = load_scenario(TWO_CIRCLES)
+    given = preloaded("ompl:RRTConnect", None)
+    assert isinstance(given, TunedRange) and given.base == "ompl:RRTConnect"
+    alone = [plan_scenario(s, "ompl:RRTConnect", seed=k, max_iter=2000) for k in range(3)]
+    monkeypatch.setattr(tuned, "tuned_params", lambda label: pytest.fail("tuned file read"))
+    for k, ref in enumerate(alone):
+        r = plan_scenario(s, "ompl:RRTConnect", rulebook=given, seed=k, max_iter=2000)
+        assert (r.params["range_deg"], r.params["range_source"]) == \
+            (ref.params["range_deg"], ref.params["range_source"])
+        assert r.iterations == ref.iterations and np.array_equal(r.path_deg, ref.path_deg)
+    # the label's own range wins and needs nothing read; another planner's range is not used
+    assert preloaded("ompl:RRTConnect:range=30", None) is None
+    r = plan_scenario(s, "ompl:RRTConnect:range=30", rulebook=given, seed=0, max_iter=500)
+    assert (r.params["range_deg"], r.params["range_source"]) == (30.0, "label")
+    monkeypatch.undo()
+    other = TunedRange("ompl:RRT", 1.0, "tuned")
+    r = plan_scenario(s, "ompl:RRTConnect", rulebook=other, seed=0, max_iter=500)
+    assert r.params["range_deg"] == alone[0].params["range_deg"]
+
+
+def test_the_protocol_reads_each_ompl_peers_tuned_range_once(monkeypatch):
+    import xfuzzy_rrt.planners.tuned as tuned
+    from xfuzzy_rrt.bench.protocol import run_protocol
+
+    reads = []
+    real = tuned.tuned_params
+    monkeypatch.setattr(tuned, "tuned_params", lambda label: reads.append(label) or real(label))
+    s = load_scenario(TWO_CIRCLES)
+    result = run_protocol([s], [("ompl:RRTConnect", "ompl:RRTConnect", None)], runs=3,
+                          max_iter=500)
+    assert len(result.runs[result.runs["planner"] == "ompl:RRTConnect"]) == 3
+    assert reads.count("ompl:RRTConnect") == 1
+
+
+def test_a_parsed_ompl_label_still_names_the_missing_extra_under_the_callers_option(
+        monkeypatch):
+    parse_ompl_label("ompl:RRT")  # parsed (and kept) while OMPL imports
+    monkeypatch.setitem(sys.modules, "ompl", None)
+    with pytest.raises(InputError) as info:
+        parse_ompl_label("ompl:RRT", "--peer")
+    assert (info.value.where, info.value.message) == ("--peer", MISSING_EXTRA)

@@ -144,11 +144,19 @@ def load_tuned_rrt(where: str = "--planner") -> TunedRRT:
 
 def preloaded(planner: str, rulebook: Any) -> Any:
     """What a caller that plans ``planner`` many times passes as ``rulebook``: ``rrt:tuned``'s
-    settings read once (:class:`TunedRRT`) when it passes nothing, else ``rulebook`` as given
+    settings read once (:class:`TunedRRT`) or an ``ompl:NAME`` label's tuned range read once
+    (:class:`~xfuzzy_rrt.planners.ompl_bridge.TunedRange`) when it passes nothing, else
+    ``rulebook`` as given
     (the shipped default of plain ``fuzzy-rrt`` is loaded by its callers:
     :func:`load_shipped_default`)."""
     if planner == RRT_TUNED and rulebook is None:
         return load_tuned_rrt()
+    if rulebook is None and planner.startswith("ompl:"):
+        from xfuzzy_rrt.planners.ompl_bridge import load_tuned_range, parse_ompl_label
+
+        spec = parse_ompl_label(planner, "--planner")
+        if spec.range_deg is None:  # the label's own range needs nothing read
+            return load_tuned_range(spec.base)
     return rulebook
 
 
@@ -361,11 +369,13 @@ def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed
 
 def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter, step_deg,
                     goal_bias, trace, clearance_m, max_time_s) -> PlanResult:
-    from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
+    from xfuzzy_rrt.planners.ompl_bridge import TunedRange, plan_ompl
 
-    # OMPL's range comes from the label (ompl:NAME:range=DEG) or the tuned file, not step_deg.
+    # OMPL's range comes from the label (ompl:NAME:range=DEG) or the tuned file (read once by
+    # a caller that passes its TunedRange), not step_deg.
     return plan_ompl(scenario, spec.label, seed=seed, max_iter=max_iter, goal_bias=goal_bias,
-                     clearance_m=clearance_m, time_limit_s=max_time_s)
+                     clearance_m=clearance_m, time_limit_s=max_time_s,
+                     tuned=rulebook if type(rulebook) is TunedRange else None)
 
 
 def _tuned_rrt(where: str) -> dict[str, float]:

@@ -117,6 +117,7 @@ from xfuzzy_rrt.geometry.collision import (CERT_MARGIN_M, config_free, edge_free
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.geometry.problem import Problem
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter, check_positive
+from xfuzzy_rrt.planners.prepared import scenario_arrays
 from xfuzzy_rrt.planners.result import PlanResult, certified_result, path_cost_deg
 
 OMPL_PREFIX = "ompl:"
@@ -200,10 +201,28 @@ class OmplLabel:
         return OMPL_PREFIX + self.name
 
 
+#: Labels :func:`parse_ompl_label` accepted, as parsed. Why: a plan parses its label twice (the
+#: registry's hook, then :func:`plan_ompl`), string work and look-ups a call that our own
+#: planners do not pay (fair comparisons). Safe to keep: with OMPL importable, a label's verdict
+#: cannot change in this process; whether it still is importable is asked again on every call
+#: (the missing extra is named under the caller's ``where``). Errors are never kept.
+_PARSED_LABELS: dict[str, OmplLabel] = {}
+
+
 def parse_ompl_label(label: str, where: str = "--planners") -> OmplLabel:
     """Validate ``ompl:NAME[:sampled][:range=DEG]`` (or ``NAME[:...]``): one InputError naming
     ``where`` for an unknown or unsupported planner, an unknown or repeated option, a range
     that is not a positive number of degrees, or a range on a planner without one."""
+    hit = _PARSED_LABELS.get(label)
+    if hit is not None:
+        import_ompl(where)
+        return hit
+    spec = _parse_ompl_label(label, where)
+    _PARSED_LABELS[label] = spec
+    return spec
+
+
+def _parse_ompl_label(label: str, where: str) -> OmplLabel:
     text = label if label.startswith(OMPL_PREFIX) else OMPL_PREFIX + label
     name, *options = text[len(OMPL_PREFIX):].split(":")
     _, og, _ = import_ompl(where)
@@ -256,25 +275,49 @@ def check_ompl_planner(name: str, where: str = "--planners") -> str:
     return parse_ompl_label(name, where).name
 
 
-def resolve_range(spec: OmplLabel, step_deg: float | None = None) -> tuple[float, str]:
+@dataclass(frozen=True)
+class TunedRange:
+    """The range ``ompl:NAME`` runs at when neither its label nor the caller gives one: the
+    shipped tuned file's (``source`` ``"tuned"``), else :data:`DEFAULT_RANGE_DEG`
+    (``"default"``), read once (:func:`load_tuned_range`). Callers that plan many problems
+    (evaluate, bench) pass it as ``plan_scenario(..., "ompl:NAME", rulebook=...)``, as they
+    pass ``rrt:tuned``'s :class:`~xfuzzy_rrt.planners.api.TunedRRT` and the default's loaded
+    rulebooks: no peer re-reads a file inside a timed call (fair comparisons)."""
+
+    base: str
+    range_deg: float
+    source: str
+
+
+def load_tuned_range(base: str) -> TunedRange:
+    """:class:`TunedRange` of ``ompl:NAME`` (``base``) as the tuned file gives it now; a broken
+    file is one InputError naming it."""
+    from xfuzzy_rrt.planners.tuned import tuned_params
+
+    tuned = tuned_params(base) or {}
+    if tuned.get("range_deg") is not None:
+        r = float(tuned["range_deg"])
+        if not (math.isfinite(r) and r > 0.0):
+            raise InputError(base, f"tuned range must be a positive number of degrees, "
+                             f"got {tuned['range_deg']!r}")
+        return TunedRange(base, r, "tuned")
+    return TunedRange(base, DEFAULT_RANGE_DEG, "default")
+
+
+def resolve_range(spec: OmplLabel, step_deg: float | None = None,
+                  tuned: TunedRange | None = None) -> tuple[float, str]:
     """``(range_deg, source)`` for a planner that has a range: the label's, else ``step_deg``
     (an explicit argument), else the tuned range of ``ompl:NAME``, else ``DEFAULT_RANGE_DEG``.
-    ``source`` is ``"label"``, ``"argument"``, ``"tuned"`` or ``"default"``."""
+    ``source`` is ``"label"``, ``"argument"``, ``"tuned"`` or ``"default"``. ``tuned``: that
+    tuned range read before (:func:`load_tuned_range`; one of another planner is ignored)."""
     if spec.range_deg is not None:
         return spec.range_deg, "label"
     if step_deg is not None:
         check_positive("step_deg", step_deg)
         return float(step_deg), "argument"
-    from xfuzzy_rrt.planners.tuned import tuned_params
-
-    tuned = tuned_params(spec.base) or {}
-    if tuned.get("range_deg") is not None:
-        r = float(tuned["range_deg"])
-        if not (math.isfinite(r) and r > 0.0):
-            raise InputError(spec.base, f"tuned range must be a positive number of degrees, "
-                             f"got {tuned['range_deg']!r}")
-        return r, "tuned"
-    return DEFAULT_RANGE_DEG, "default"
+    if tuned is None or tuned.base != spec.base:
+        tuned = load_tuned_range(spec.base)
+    return tuned.range_deg, tuned.source
 
 
 def ompl_seed(seed: int) -> int:
@@ -507,12 +550,14 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
               step_deg: float | None = None, goal_bias: float = 0.05,
               margin: float | None = None, time_limit_s: float | None = None,
               validity_resolution: float | None = None,
-              clearance_m: float | None = None) -> PlanResult:
+              clearance_m: float | None = None,
+              tuned: TunedRange | None = None) -> PlanResult:
     """Plan ``scenario`` with the OMPL planner a label names (``"ompl:RRTConnect"``,
     ``"ompl:RRT:sampled:range=60"``, or a bare ``"RRT"``).
 
     ``step_deg`` sets the range when the label does not (``None``: the tuned range, else
-    ``DEFAULT_RANGE_DEG``). ``validity_resolution`` is OMPL's state-validity checking resolution
+    ``DEFAULT_RANGE_DEG``; ``tuned``: that range read once, :func:`load_tuned_range`).
+    ``validity_resolution`` is OMPL's state-validity checking resolution
     as a fraction of the space's extent, for ``:sampled`` only (``None``: OMPL's default 0.01).
     See the module docstring for everything else; the returned ``PlanResult.planner`` is the
     label (with its ``ompl:`` prefix).
@@ -536,8 +581,9 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
             raise InputError("validity_resolution", "sets OMPL's sampled motion check: use "
                              f"{spec.base}:{SAMPLED_OPTION}")
     has_range = hasattr(getattr(og, bare), "setRange")
-    range_deg, range_source = resolve_range(spec, step_deg) if has_range else (None, None)
-    a = scenario.arrays()
+    range_deg, range_source = resolve_range(spec, step_deg, tuned) if has_range else (None, None)
+    # built once per scenario object, as for our planners (read only here)
+    a = scenario_arrays(scenario)
     dof = a.links.shape[0]
     counts = new_counts()
 

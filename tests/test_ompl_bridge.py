@@ -418,12 +418,13 @@ def test_the_compiled_checks_are_ready_at_import_not_compiled_inside_a_timed_sol
     import subprocess
 
     code = ("import os, xfuzzy_rrt.planners.ompl_bridge as b; "
-            "print(len(b.state_free_at.overloads), len(b.motion_free_at.overloads), flush=True); "
+            "print(len(b.state_free_at.overloads), len(b.motion_free_at.overloads), "
+            "len(b.motion_free_logged_at.overloads), flush=True); "
             "os._exit(0)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=600, cwd=PROJECT)
     assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.split() == ["1", "1"]
+    assert proc.stdout.split() == ["1", "1", "1"]
 
 
 def test_an_ompl_range_read_once_plans_exactly_as_the_label_alone_and_is_not_read_again(
@@ -473,3 +474,72 @@ def test_a_parsed_ompl_label_still_names_the_missing_extra_under_the_callers_opt
     with pytest.raises(InputError) as info:
         parse_ompl_label("ompl:RRT", "--peer")
     assert (info.value.where, info.value.message) == ("--peer", MISSING_EXTRA)
+
+
+def test_a_path_segment_counts_as_certified_only_if_it_is_an_accepted_motion_bit_for_bit():
+    from xfuzzy_rrt.planners.ompl_bridge import segments_logged
+
+    log = np.zeros((4, 2, 3))
+    log[0] = [[0.0, 0.0, 0.0], [10.0, 5.0, 1.0]]
+    log[1] = [[20.0, 5.0, 1.0], [10.0, 5.0, 1.0]]  # accepted the other way round
+    path = np.array([[0.0, 0.0, 0.0], [10.0, 5.0, 1.0], [20.0, 5.0, 1.0]])
+    assert segments_logged(path, log, 2)
+    assert not segments_logged(path, log, 1)  # only the motions logged so far count
+    nudged = path.copy()
+    nudged[2, 2] = np.nextafter(1.0, 2.0)
+    assert not segments_logged(nudged, log, 2)
+
+
+def test_the_certified_validator_logs_accepted_motions_only_and_stops_when_full():
+    ob = pytest.importorskip("ompl.base")
+    a = load_scenario(TWO_CIRCLES).arrays()
+    space = ob.RealVectorStateSpace(2)
+    bounds = ob.RealVectorBounds(2)
+    for j in range(2):
+        bounds.setLow(j, float(a.limits_deg[j, 0]))
+        bounds.setHigh(j, float(a.limits_deg[j, 1]))
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(make_validity_callback(a))
+    validator = certified_motion_validator(si, space, a)
+    validator.log_meta[1] = 3  # room for three
+    si.setMotionValidator(validator)
+    si.setup()
+    s1, s2 = space.allocState(), space.allocState()
+    rng = np.random.default_rng(5)
+    accepted = []
+    for _ in range(200):
+        qa, qb = rng.uniform(-180.0, 180.0, size=(2, 2))
+        for j in range(2):
+            s1[j], s2[j] = float(qa[j]), float(qb[j])
+        if si.checkMotion(s1, s2):
+            accepted.append((qa, qb))
+    assert len(accepted) > 3 and len(accepted) < 200
+    assert validator.log_meta[0] == 3
+    for k in range(3):
+        assert np.array_equal(validator.log[k, 0], accepted[k][0])
+        assert np.array_equal(validator.log[k, 1], accepted[k][1])
+    assert validator.certified(np.array(accepted[1]))
+    assert not validator.certified(np.array(accepted[3]))  # accepted, but not logged
+
+
+def test_ompl_paths_of_logged_motions_skip_the_second_certification_others_get_it(
+        monkeypatch):
+    import xfuzzy_rrt.planners.ompl_bridge as bridge
+    import xfuzzy_rrt.geometry.path_check as path_check
+
+    s = load_scenario(TWO_CIRCLES)
+    calls = []
+    real = path_check.segments_certified
+    monkeypatch.setattr(path_check, "segments_certified",
+                        lambda *args: calls.append(1) or real(*args))
+    r = plan_scenario(s, "ompl:RRTConnect", seed=1)
+    assert r.success and r.params["path_check"] == "motions certified in planning"
+    assert calls == [] and r.certify_work == 0
+    sampled = plan_scenario(s, "ompl:RRTConnect:sampled", seed=1)
+    assert sampled.params["path_check"] == "certified after planning" and calls == [1]
+    monkeypatch.setattr(bridge, "MOTION_LOG", 0)  # nothing logged: the path is certified after
+    again = plan_scenario(s, "ompl:RRTConnect", seed=1)
+    assert again.params["path_check"] == "certified after planning" and calls == [1, 1]
+    assert again.success and np.array_equal(again.path_deg, r.path_deg)
+    assert again.certify_work > 0

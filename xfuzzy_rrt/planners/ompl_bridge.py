@@ -68,11 +68,17 @@ an OMPL run here is set up exactly as our planners are
   "sampled"``): OMPL's ``DiscreteMotionValidator`` at OMPL's default resolution (1 % of the
   space's extent, about 5.1° for ±180° limits, unless ``validity_resolution`` is given), kept
   to show what sampling an edge costs in penetrating paths.
-- **Belt and braces**: either way the raw path is put through
-  :func:`~xfuzzy_rrt.geometry.path_check.certify_path` like every planner's
-  (:func:`~xfuzzy_rrt.planners.result.certified_result`): ``found`` is OMPL's exact solution,
-  ``success`` needs ``certified`` too, and a grazing path (possible only with ``:sampled``)
-  reports where and how deep it goes (``violation``, ``penetration_m``, ``min_clearance_m``).
+- **Belt and braces**: the raw path goes through
+  :func:`~xfuzzy_rrt.planners.result.certified_result` like every planner's: ``found`` is
+  OMPL's exact solution, ``success`` needs ``certified`` too, and a grazing path (possible only
+  with ``:sampled``) reports where and how deep it goes (``violation``, ``penetration_m``,
+  ``min_clearance_m``). With the certified validator, the validator logs the motions it accepts
+  (:func:`motion_free_logged_at`, up to :data:`MOTION_LOG`); a path whose every segment is a
+  logged motion bit for bit (either way round; the edge to an appended goal is certified by
+  ``segment_free``) is certified already and is not checked a second time -- our own planners'
+  tree edges are not either (fair comparisons: the second check was 5-8 % of an OMPL call).
+  Any other path, and every ``:sampled`` one, is certified after planning
+  (``params["path_check"]`` says which).
 - **Counts**: ``params["state_checks"]`` and ``params["motions_checked"]`` count the checks
   OMPL asked for. ``params["work"]`` is the number of exact element distance evaluations of
   those checks when the problem bundle counts them (``Problem.work``, interfaces.md item 1),
@@ -426,6 +432,12 @@ def _at(typingctx, address):
 #: first plan of a process does not compile inside OMPL's timed ``solve`` (and hit its cap).
 _AT3 = nb.types.boolean(nb.types.intp, nb.types.intp, nb.types.intp)
 _AT4 = nb.types.boolean(nb.types.intp, nb.types.intp, nb.types.intp, nb.types.intp)
+_AT6 = nb.types.boolean(nb.types.intp, nb.types.intp, nb.types.intp, nb.types.intp,
+                        nb.types.intp, nb.types.intp)
+#: Accepted motions a certified validator remembers (:func:`motion_free_logged_at`): enough for
+#: the runs where checking the path again would matter; a run that accepts more simply has its
+#: path certified again (~110 KB at 7 joints, allocated per plan, never touched beyond use).
+MOTION_LOG = 1024
 
 
 @nb.njit(_AT3, cache=True, nogil=True, _nrt=True)
@@ -466,6 +478,56 @@ def motion_free_at(qa_at, qb_at, buffer_at, counts_at):
     if not ok:
         counts[MOTIONS_REFUSED] += 1
     return ok
+
+
+@nb.njit(_AT6, cache=True, nogil=True, _nrt=True)
+def motion_free_logged_at(qa_at, qb_at, buffer_at, counts_at, log_at, meta_at):
+    """:func:`motion_free_at`, and an accepted motion's two ends copied into the log at
+    ``log_at`` (``[cap, 2, dof]`` float64; ``meta_at``: int64 ``[logged, cap]``) while it has
+    room. Why: the path OMPL returns is made of motions this validator accepted, and a path
+    segment found in the log, bit for bit, was certified at this margin already (the
+    certificate covers the segment's configurations, whichever way it was checked), so the
+    result need not certify it again: our own planners are not made to certify their tree
+    edges twice either (fair comparisons; :func:`segments_logged`)."""
+    ok = motion_free_at(qa_at, qb_at, buffer_at, counts_at)
+    if ok:
+        meta = carray(_at(meta_at), (2,), dtype=np.int64)
+        n = meta[0]
+        if n < meta[1]:
+            ptr = _at(buffer_at)
+            dof = int(carray(ptr, (_HEADER,), dtype=np.float64)[0])
+            log = carray(_at(log_at), (meta[1], 2, dof), dtype=np.float64)
+            qa = carray(_at(qa_at), (dof,), dtype=np.float64)
+            qb = carray(_at(qb_at), (dof,), dtype=np.float64)
+            for j in range(dof):
+                log[n, 0, j] = qa[j]
+                log[n, 1, j] = qb[j]
+            meta[0] = n + 1
+    return ok
+
+
+@nb.njit(cache=True, nogil=True, _nrt=False)
+def segments_logged(path, log, n_logged):
+    """Whether every segment of ``path`` (``[k, dof]``) is one of the first ``n_logged``
+    motions of ``log`` (``[cap, 2, dof]``), exactly, in either direction."""
+    dof = path.shape[1]
+    for i in range(path.shape[0] - 1):
+        found = False
+        for m in range(n_logged):
+            for end in range(2):
+                same = True
+                for j in range(dof):
+                    if log[m, end, j] != path[i, j] or log[m, 1 - end, j] != path[i + 1, j]:
+                        same = False
+                        break
+                if same:
+                    found = True
+                    break
+            if found:
+                break
+        if not found:
+            return False
+    return True
 
 
 def new_counts() -> np.ndarray:
@@ -523,9 +585,20 @@ def _certified_validator_class():
             self._qb = np.empty(dof, dtype=np.float64)
             self._buffer = pack_scenario(arrays, margin)
             self._counts = counts
-            self._fn = motion_free_at
+            #: the accepted motions (motion_free_logged_at) and ``[logged, capacity]``
+            self.log = np.empty((MOTION_LOG, 2, dof), dtype=np.float64)
+            self.log_meta = np.array([0, MOTION_LOG], dtype=np.int64)
+            self._fn = motion_free_logged_at
             self._args = (self._qa.ctypes.data, self._qb.ctypes.data,
-                          self._buffer.ctypes.data, counts.ctypes.data)
+                          self._buffer.ctypes.data, counts.ctypes.data, self.log.ctypes.data,
+                          self.log_meta.ctypes.data)
+
+        def certified(self, path: np.ndarray) -> bool:
+            """Whether every segment of ``path`` is a motion this validator accepted (exactly,
+            either way: :func:`segments_logged`), so certified already at its margin."""
+            n = int(self.log_meta[0])
+            return path.shape[0] >= 2 and n > 0 and bool(
+                segments_logged(np.ascontiguousarray(path, dtype=np.float64), self.log, n))
 
         def checkMotion(self, s1, s2):  # noqa: N802 - OMPL's name
             self._project(s1, self._qa)
@@ -600,11 +673,13 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
         space.setBounds(bounds)
         si = ob.SpaceInformation(space)
         si.setStateValidityChecker(make_validity_callback(a, margin, counts, space))
+        validator = None
         if spec.sampled:
             if validity_resolution is not None:
                 si.setStateValidityCheckingResolution(float(validity_resolution))
         else:
-            si.setMotionValidator(certified_motion_validator(si, space, a, margin, counts))
+            validator = certified_motion_validator(si, space, a, margin, counts)
+            si.setMotionValidator(validator)
         si.setup()
         start = space.allocState()
         goal = space.allocState()
@@ -716,8 +791,19 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
     }
     if failure is not None:
         params["failure"] = failure
+    # A path whose every segment is a motion the certified validator accepted, bit for bit (the
+    # one to an appended goal was certified by segment_free above), is certified already: it is
+    # not checked again, as our planners' tree edges are not (a sampled validator's always is).
+    edges_certified = False
+    if exact and validator is not None:
+        head = path[:-1] if goal_appended else path
+        edges_certified = (goal_appended and head.shape[0] < 2) or validator.certified(head)
+    if exact:
+        params["path_check"] = "motions certified in planning" if edges_certified \
+            else "certified after planning"
     result = certified_result(
-        a, margin, exact, scenario=scenario.name, planner=spec.label, seed=int(seed),
+        a, margin, exact, edges_certified=edges_certified,
+        scenario=scenario.name, planner=spec.label, seed=int(seed),
         iterations=iterations, nodes=n, cost_deg=path_cost_deg(path) if exact else None,
         wall_s=wall, path_deg=path, tree_nodes_deg=tree, tree_parent=parent, params=params,
         work=params["work"],

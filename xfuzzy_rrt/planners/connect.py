@@ -100,7 +100,7 @@ from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.planners.prepared import pooled_trees, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import exact, remembered_for_rulebook, rulebook_token
+from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
 from xfuzzy_rrt.planners.trace_record import TraceArrays, idle_buffers
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
@@ -387,18 +387,19 @@ def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots
     an untraced call unboxes 16 arrays fewer (half its arguments; ~12 us of a 3-joint call
     with cold caches, README "Cold calls")."""
     P = Problem(*p)
-    counts = np.zeros(1, dtype=np.int64)
     if tr is None:
-        ok, it, last_a, last_b = connect_kernel(
-            P, reversed_problem(P), emptied_tree_in(block_a, layout_a),
-            emptied_tree_in(block_b, layout_b), seed, max_iter, knots, consts, scale, min_step,
-            stop, record, idle_buffers(P.start.shape[0], knots.shape[0], 1),
-            np.zeros(1, dtype=np.int8), np.zeros(1, dtype=np.int64), counts)
+        TR = idle_buffers(P.start.shape[0], knots.shape[0], 1)
+        tree_of_row = np.zeros(1, dtype=np.int8)
+        connected = np.zeros(1, dtype=np.int64)
     else:
-        ok, it, last_a, last_b = connect_kernel(
-            P, reversed_problem(P), emptied_tree_in(block_a, layout_a),
-            emptied_tree_in(block_b, layout_b), seed, max_iter, knots, consts, scale, min_step,
-            stop, record, TraceArrays(*tr), grown, connect_nodes, counts)
+        TR = TraceArrays(*tr)
+        tree_of_row = grown
+        connected = connect_nodes
+    counts = np.zeros(1, dtype=np.int64)
+    ok, it, last_a, last_b = connect_kernel(
+        P, reversed_problem(P), emptied_tree_in(block_a, layout_a),
+        emptied_tree_in(block_b, layout_b), seed, max_iter, knots, consts, scale, min_step, stop,
+        record, TR, tree_of_row, connected, counts)
     return ok, it, last_a, last_b, counts[0]
 
 
@@ -444,9 +445,9 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
     resolves to the same object (a call without a time budget or a trace)."""
     key = (PLANNER, id(scenario), rulebook_token(rulebook), exact(max_iter),
            exact(min_step_deg), exact(margin), exact(clearance_m))
-    return remembered_for_rulebook(key, scenario, rulebook, _resolve_rulebook,
-                                   lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
-                                                    margin, clearance_m, None))
+    return remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
+                                                      margin, clearance_m, None),
+                      rulebook, _resolve_rulebook)
 
 
 def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,

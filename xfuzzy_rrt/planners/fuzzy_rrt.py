@@ -77,7 +77,7 @@ from xfuzzy_rrt.planners.trace_record import (
     record_iteration,
 )
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import exact, remembered_for_rulebook, rulebook_token
+from xfuzzy_rrt.planners.setup_memo import exact, remembered, rulebook_token
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
@@ -376,9 +376,9 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
     resolves to the same object (a call without a time budget or a trace)."""
     key = ("fuzzy-rrt", id(scenario), rulebook_token(rulebook), exact(max_iter),
            exact(min_step_deg), exact(margin), exact(clearance_m))
-    return remembered_for_rulebook(key, scenario, rulebook, _resolve_rulebook,
-                                   lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
-                                                    margin, clearance_m, None))
+    return remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter, min_step_deg,
+                                                      margin, clearance_m, None),
+                      rulebook, _resolve_rulebook)
 
 
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,

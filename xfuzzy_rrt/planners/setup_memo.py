@@ -99,34 +99,21 @@ def _forget(key: Hashable, ref: weakref.ref) -> None:
         _memo.pop(key, None)
 
 
-def remembered(key: Hashable, scenario: Any, prepare: Callable[[], Any],
-               still_valid: Callable[[Any], bool] | None = None) -> Any:
-    """The set-up remembered for ``key`` and this ``scenario`` if ``still_valid(it)`` (e.g. the
-    rulebook still resolves to the object it was built for), else ``prepare()``, remembered.
-    ``prepare`` runs every check, so an error is raised, not remembered."""
+def remembered(key: Hashable, scenario: Any, prepare: Callable[[], Any], rulebook: Any = None,
+               resolve: Callable[[Any], Any] | None = None) -> Any:
+    """The set-up remembered for ``key`` and this ``scenario``, else ``prepare()``, remembered.
+    ``prepare`` runs every check, so an error is raised, not remembered.
+
+    With ``resolve`` (a planner whose set-up holds the resolved rulebook ``rb``): valid only
+    while the ``rulebook`` argument resolves to that very object. A loaded rulebook given as the
+    argument *is* the one it resolves to (and the entry keeps it alive, so its ``id`` in the key
+    cannot be reused), so it is compared directly; a directory or ``None`` is resolved again (an
+    edited directory loads as a new object). Why no callback: with the caches cold (a
+    benchmark's other planners, a program between plans) each Python call of a plan costs
+    microseconds, and the default's set-up took ~10 us more than the tuned RRT's."""
     hit = lookup(key, scenario)
-    if hit is not None and (still_valid is None or still_valid(hit)):
+    if hit is not None and (resolve is None or hit.rb is rulebook or resolve(rulebook) is hit.rb):
         return hit
-    setup = prepare()
-    remember(key, scenario, setup)
-    return setup
-
-
-def remembered_for_rulebook(key: Hashable, scenario: Any, rulebook: Any,
-                            resolve: Callable[[Any], Any], prepare: Callable[[], Any]) -> Any:
-    """:func:`remembered` for a planner whose set-up holds the resolved rulebook ``rb``: valid
-    while ``rulebook`` resolves to that very object. A loaded rulebook given as the argument
-    *is* the one it resolves to (and the entry keeps it alive, so its ``id`` in the key cannot
-    be reused), so it is compared directly; a directory or ``None`` is resolved again (an
-    edited directory loads as a new object). Why not ``remembered`` with a ``still_valid``
-    callback: with the caches cold (a benchmark's other planners, a program between plans)
-    each Python call of a plan costs microseconds, and the default's set-up took ~10 us more
-    than the tuned RRT's."""
-    hit = _memo.get(key)
-    if hit is not None and hit[0]() is scenario:
-        setup = hit[1]
-        if setup.rb is rulebook or resolve(rulebook) is setup.rb:
-            return setup
     setup = prepare()
     remember(key, scenario, setup)
     return setup

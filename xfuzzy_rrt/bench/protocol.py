@@ -39,6 +39,10 @@ the tuned RRT (``rrt:tuned``, shipped tuned file) when it runs -- by default it 
 against RRT; the summary names that baseline (``time_work_baseline``) and ranks planners by
 their median end-to-end time ratio (``time_rank``, 1 = fastest). Iteration ratios stay
 against the paper's RRT (10°, goal bias 0.05).
+
+**The caches a timed call starts from** (:mod:`xfuzzy_rrt.bench.caches`) are named, not left
+to the neighbours: ``cold`` (default: evicted before every timed call), ``warm`` (a planner's
+seeds in a row) or ``shuffled`` (the earlier order); the summary's ``caches`` column says which.
 """
 
 from __future__ import annotations
@@ -48,6 +52,8 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from xfuzzy_rrt.bench.caches import DEFAULT_CACHE_MODE, CacheEvictor, check_cache_mode
 
 PROBLEM_COLUMNS = ["scenario", "planner", "runs", "success_rate", "median_iterations",
                    "median_cost_deg", "median_time_s", "iteration_ratio", "cost_ratio",
@@ -59,7 +65,7 @@ SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "wors
                    "median_time_s", "time_work_baseline", "time_rank", "median_time_total_ratio",
                    "worst_time_total_ratio", "problems_lost_time", "median_work_total_ratio",
                    "worst_work_total_ratio", "problems_lost_work_total", "median_time_total_s",
-                   "median_work", "median_work_total"]
+                   "median_work", "median_work_total", "caches"]
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "cost_deg", "wall_s",
                "time_total_s", "work", "work_total", "planner_used", "rulebook",
                "rulebook_sha256"]
@@ -102,13 +108,24 @@ def call_order(n: int, k: int) -> list[int]:
     return [int(i) for i in np.random.default_rng([0x5EED, k]).permutation(n)]
 
 
+def block_order(n: int, i: int) -> list[int]:
+    """The order of the ``n`` planners' blocks of runs on the ``i``-th problem under the
+    ``warm`` cache mode: a shuffle fixed by ``i``."""
+    return [int(x) for x in np.random.default_rng([0x5EED, 0xB10C, i]).permutation(n)]
+
+
 def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs: int = 50,
                  seed: int = 0, max_iter: int = 10_000, progress=None,
-                 clearance_m: float | None = None) -> ProtocolResult:
+                 clearance_m: float | None = None,
+                 caches: str = DEFAULT_CACHE_MODE) -> ProtocolResult:
     """Run RRT and every ``(label, planner, rulebook)`` of *planners* on every scenario (put
     ``("rrt:tuned", "rrt:tuned", None)`` among them to rank against the tuned RRT).
 
     ``clearance_m`` is the certified margin every planner must keep (``None``: each scenario's).
+    ``caches``: the state each timed call starts from (:mod:`xfuzzy_rrt.bench.caches`):
+    ``cold`` (evicted before every call), ``warm`` (each planner's seeds of a problem in a row,
+    after an untimed call) or ``shuffled`` (planners shuffled per seed, nothing evicted). Only
+    the timings depend on it.
 
     ``planner`` is a name :func:`~xfuzzy_rrt.planners.api.plan_scenario` takes (``fuzzy-rrt``
     with a loaded ``rulebook`` or the :class:`~xfuzzy_rrt.planners.api.ShippedDefault`, or
@@ -117,6 +134,7 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     """
     from xfuzzy_rrt.planners.api import preloaded
 
+    check_cache_mode(caches)
     # rrt:tuned's settings read once, as the default's rulebooks are (api.TunedRRT)
     entries = [("rrt", "rrt", None), *((label, planner, preloaded(planner, rb))
                                        for label, planner, rb in planners)]
@@ -135,20 +153,40 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
         for sc in warm:
             for _label, planner, rb in entries:
                 _one(sc, planner, rb, seed, min(max_iter, 100), clearance_m)
-    for sc in scenarios:
-        # Seeds outer, planners inner: every planner runs seed k under the same machine
-        # conditions, so a burst of load blurs all planners alike, not one planner's block.
-        # The order is shuffled per seed (the same shuffles in every run: timing only, the
-        # results do not depend on it): in a fixed order rrt:tuned always ran right after rrt,
-        # whose identical kernel, arrays and tree had just warmed the caches for it, while
-        # the planner after it found them cold; a rotation keeps that neighbour (README, "the
-        # order of calls"). Shuffled, each planner follows each other one as often.
+    evict = CacheEvictor() if caches == "cold" else None
+    n = len(entries)
+    for i, sc in enumerate(scenarios):
         per = {label: [] for label, _, _ in entries}
-        for k in range(runs):
-            for i in call_order(len(entries), k):
-                label, planner, rb = entries[i]
-                per[label].append({"scenario": sc.name, "planner": label, "seed": seed + k,
-                                   **_one(sc, planner, rb, seed + k, max_iter, clearance_m)})
+
+        def timed(e: int, k: int) -> None:
+            label, planner, rb = entries[e]
+            if evict is not None:
+                evict()
+            per[label].append({"scenario": sc.name, "planner": label, "seed": seed + k,
+                               **_one(sc, planner, rb, seed + k, max_iter, clearance_m)})
+
+        if caches == "warm":
+            # Each planner's seeds in a row after one untimed call of its first seed: the
+            # calls a user who plans in a loop makes. The blocks' order is shuffled per
+            # problem, so no planner always follows another.
+            for e in block_order(n, i):
+                label, planner, rb = entries[e]
+                _one(sc, planner, rb, seed, max_iter, clearance_m)
+                for k in range(runs):
+                    timed(e, k)
+        else:
+            # Seeds outer, planners inner: every planner runs seed k under the same machine
+            # conditions, so a burst of load blurs all planners alike, not one planner's
+            # block. The order is shuffled per seed (the same shuffles in every run: timing
+            # only, the results do not depend on it): in a fixed order rrt:tuned always ran
+            # right after rrt, whose identical kernel, arrays and tree had just warmed the
+            # caches for it; a rotation keeps that neighbour (README, "the order of calls").
+            # Shuffled, each planner follows each other one as often -- yet rrt:tuned still
+            # starts warm whenever rrt ran before it in the seed's round, which is why the
+            # default mode (cold) evicts the caches before every timed call.
+            for k in range(runs):
+                for e in call_order(n, k):
+                    timed(e, k)
         for label, _, _ in entries:
             rows.extend(per[label])
             done += 1
@@ -158,7 +196,8 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     for col in ("work", "work_total"):
         frame[col] = frame[col].astype("Int64")
     problems = problem_table(frame, [e[0] for e in entries])
-    return ProtocolResult(runs=frame, problems=problems, summary=summary_table(problems))
+    return ProtocolResult(runs=frame, problems=problems,
+                          summary=summary_table(problems, caches=caches))
 
 
 def problem_table(runs: pd.DataFrame, order: list[str]) -> pd.DataFrame:
@@ -208,8 +247,9 @@ def _dist(values) -> tuple[float, float, int]:
     return float(np.median(r)), float(r.min()), int((r < 1.0).sum())
 
 
-def summary_table(problems: pd.DataFrame) -> pd.DataFrame:
-    """One row per planner (RRT included, whose ratios are 1 by construction)."""
+def summary_table(problems: pd.DataFrame, caches: str = "") -> pd.DataFrame:
+    """One row per planner (RRT included, whose ratios are 1 by construction); ``caches``
+    names the cache mode the times were measured in (:mod:`xfuzzy_rrt.bench.caches`)."""
     rows = []
     peer = time_work_baseline(problems["planner"])
     rrt_success = problems[problems["planner"] == "rrt"].set_index("scenario")["success_rate"]
@@ -226,9 +266,9 @@ def summary_table(problems: pd.DataFrame) -> pd.DataFrame:
             "problems_lost": int((r < 1.0).sum()) if has else 0,
             "worst_success_rate": float(g["success_rate"].min()),
             "problems_success_below_rrt": int(below),
-            "median_cost_ratio": float(np.nanmedian(g["cost_ratio"])),
-            "median_time_ratio": float(np.nanmedian(g["time_ratio"])),
-            "median_time_s": float(np.nanmedian(g["median_time_s"])),
+            "median_cost_ratio": _nanmedian(g["cost_ratio"]),
+            "median_time_ratio": _nanmedian(g["time_ratio"]),
+            "median_time_s": _nanmedian(g["median_time_s"]),
         })
         t_med, t_worst, t_lost = _dist(g["time_total_ratio"])
         w_med, w_worst, w_lost = _dist(g["work_total_ratio"])
@@ -240,6 +280,7 @@ def summary_table(problems: pd.DataFrame) -> pd.DataFrame:
             "median_time_total_s": _nanmedian(g["median_time_total_s"]),
             "median_work": _nanmedian(g["median_work"]),
             "median_work_total": _nanmedian(g["median_work_total"]),
+            "caches": caches,
         })
     frame = pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
     # Rank on end-to-end time (1 = the largest median ratio to the baseline); ties share.

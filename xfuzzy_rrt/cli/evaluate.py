@@ -40,6 +40,7 @@ def evaluate(
     max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run; a failure counts as this many iterations."),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for runs.csv, problems.csv and summary.csv."),
     clearance: Optional[float] = typer.Option(None, "--clearance", help="Certified clearance in metres every planner must keep (default: each scenario's [safety] clearance_m, else 0)."),
+    caches: str = typer.Option("cold", "--caches", help="The state every timed call starts from: cold (the caches evicted before each call: a plan made between other work), warm (each planner's seeds of a problem in a row after an untimed call: plans made in a loop) or shuffled (planners shuffled per seed, nothing evicted: the tenth and eleventh sessions' figures). Only timings depend on it."),
 ) -> int:
     """Evaluate rulebooks against RRT on a folder of problems: planners ranked on end-to-end
     time to the first certified path and on work against the tuned RRT (rrt:tuned), and on
@@ -51,9 +52,12 @@ def evaluate(
     from xfuzzy_rrt.planners.api import check_planner
     from xfuzzy_rrt.planners.checks import check_max_iter
 
+    from xfuzzy_rrt.bench.caches import check_cache_mode
+
     if not 1 <= runs <= 100_000:
         raise InputError("--runs", f"must lie in [1, 100000], got {runs}")
     check_max_iter(max_iter)
+    check_cache_mode(caches)
     if clearance is not None:
         from xfuzzy_rrt.geometry.collision import check_clearance
 
@@ -110,7 +114,7 @@ def evaluate(
             sys.stderr.flush()
 
     result = run_protocol(scenarios, entries, runs=runs, seed=seed, max_iter=max_iter,
-                          progress=progress, clearance_m=clearance)
+                          progress=progress, clearance_m=clearance, caches=caches)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     if out is not None:
@@ -121,7 +125,8 @@ def evaluate(
                f"end-to-end time to the first certified path (the whole call) and on end-to-end "
                f"work (search + certification of the path), "
                f"against {_describe(base)}; iterations (the paper's measure) against RRT "
-               f"(step 10 deg, goal bias 0.05). A failed run counts with the time, work and "
+               f"(step 10 deg, goal bias 0.05). Times measured with {caches} caches "
+               f"({_CACHES[caches]}). A failed run counts with the time, work and "
                f"iterations ({max_iter}) it spent; cost ratio = planner / RRT (median over "
                "successful runs)")
     header = ["rank", "planner", "time", "worst", "lost", "e2e work", "worst", "lost",
@@ -145,6 +150,11 @@ def evaluate(
     if out is not None:
         typer.echo(f"wrote {out}/runs.csv, problems.csv, summary.csv")
     return 0
+
+
+_CACHES = {"cold": "evicted before every timed call",
+           "warm": "each planner's seeds of a problem in a row, after an untimed call",
+           "shuffled": "planners shuffled per seed, nothing evicted"}
 
 
 def _describe(label: str) -> str:

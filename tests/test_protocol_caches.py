@@ -136,3 +136,8 @@ def test_an_eviction_writes_more_than_the_last_level_cache():
     before = evict.buffer.copy()
     evict()
     assert np.all(evict.buffer == before + 1.0)  # every byte written, none skipped
+
+
+def test_the_eviction_buffer_is_capped_on_machines_that_report_huge_caches():
+    assert caches.evict_bytes(64 * 2**30) == caches.MAX_EVICT_BYTES
+    assert caches.evict_bytes(32 * 2**20) == 48 * 2**20

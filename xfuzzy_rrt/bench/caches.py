@@ -35,6 +35,10 @@ FALLBACK_LLC_BYTES = 32 * 2**20
 #: its size leaves some lines of a non-LRU cache in place).
 EVICT_FACTOR = 1.5
 
+#: ...but never more than this (a machine that reports a very large cache would otherwise get
+#: a buffer of gigabytes and seconds of writing per call).
+MAX_EVICT_BYTES = 512 * 2**20
+
 
 def last_level_cache_bytes(root: Path = Path("/sys/devices/system/cpu/cpu0/cache")) -> int:
     """Size in bytes of the largest data or unified cache the OS lists for CPU 0 (Linux
@@ -55,12 +59,19 @@ def last_level_cache_bytes(root: Path = Path("/sys/devices/system/cpu/cpu0/cache
     return best or FALLBACK_LLC_BYTES
 
 
+def evict_bytes(llc_bytes: int) -> int:
+    """How many bytes an eviction writes on a machine whose last-level cache has
+    *llc_bytes*."""
+    return min(int(EVICT_FACTOR * llc_bytes), MAX_EVICT_BYTES)
+
+
 class CacheEvictor:
-    """Writes a buffer of :data:`EVICT_FACTOR` times the last-level cache on each call (~2 ms
-    for 48 MB), pushing every earlier call's code and data out of all cache levels."""
+    """Writes a buffer of :data:`EVICT_FACTOR` times the last-level cache (at most
+    :data:`MAX_EVICT_BYTES`) on each call (~2 ms for 48 MB), pushing every earlier call's code
+    and data out of all cache levels."""
 
     def __init__(self, llc_bytes: int | None = None):
-        size = int(EVICT_FACTOR * (llc_bytes or last_level_cache_bytes()))
+        size = evict_bytes(llc_bytes or last_level_cache_bytes())
         self.buffer = np.zeros(max(size // 8, 1))
         self.bytes = self.buffer.nbytes
 

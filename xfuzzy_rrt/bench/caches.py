@@ -1,14 +1,14 @@
 """The state of the CPU caches a timed call starts from: what the fair protocol controls.
 
-Why this matters: a short plan takes 30-200 us, and a call whose code and data are out of the
-caches takes up to twice as long as the same call repeated (README, "Cold calls"). A protocol
-that calls several planners in turn leaves each call with whatever the previous calls left, so
-a planner that shares its compiled kernel with another one in the run (``rrt:tuned`` and the
-paper's ``rrt`` are one kernel) starts warm whenever its sibling ran before it, and a planner
-with no sibling never does. Measured in the eleventh session's runs: ``rrt:tuned`` right after
-``rrt`` took 0.69-0.82x its time after any other planner on 2- and 3-joint problems, the
-default planner 0.85-1.02x. So the protocol names the state every timed call starts from
-(:data:`CACHE_MODES`), and no neighbour decides it:
+Why this matters: a short plan takes 20-200 us when repeated, and a call whose code and data
+are out of the caches takes several times as long (README, "Against tuned peers", twelfth
+session: 164 against 26 us at 2 joints). A protocol that calls several planners in turn leaves
+each call with whatever the previous calls left, so a planner that shares its compiled kernel
+with another one in the run (``rrt:tuned`` and the paper's ``rrt`` are one kernel) starts warm
+whenever its sibling ran before it, and a planner with no sibling never does. Measured in the
+eleventh session's runs: ``rrt:tuned`` right after ``rrt`` took 0.69-0.82x its time after any
+other planner on 2- and 3-joint problems, the default planner 0.85-1.02x. So the protocol names
+the state every timed call starts from (:data:`CACHE_MODES`), and no neighbour decides it:
 
 - ``cold``: a buffer larger than the last-level cache is written before every timed call, so
   every call starts with its code and data evicted (a user who plans once in a while, between

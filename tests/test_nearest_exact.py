@@ -136,3 +136,32 @@ def test_a_plan_that_grows_two_trees_gets_two_distinct_pooled_trees_back_each_ti
     assert again[0] is a and again[1] is b
     single = pooled_tree(100, limits).block
     assert single is not a.block and single is not b.block
+
+
+def test_pooled_trees_are_found_by_the_limits_array_and_by_equal_values_alike():
+    from xfuzzy_rrt.planners.prepared import pooled_trees
+
+    limits = _limits(3)
+    first = pooled_trees(64, limits, 1)
+    assert pooled_trees(64, limits, 1) is first  # the same array: the identity look-up
+    assert pooled_trees(64, limits.copy(), 1) is first  # equal values: the same pooled tree
+    other = limits.copy()
+    other[0, 1] -= 1.0
+    assert pooled_trees(64, other, 1) is not first  # other limits: another tree
+    assert pooled_trees(65, limits, 1) is not first and pooled_trees(64, limits, 2) is not first
+
+
+def test_pooled_trees_keep_no_more_trees_alive_than_the_pool_holds():
+    import gc
+    import weakref
+
+    from xfuzzy_rrt.planners import prepared
+
+    made = []
+    for k in range(prepared._TREES_PER_THREAD + 3):
+        limits = _limits(2)
+        limits[0, 1] -= k  # distinct values: a new pool entry each
+        made.append(weakref.ref(prepared.pooled_trees(32, limits, 1)[0].block))
+    gc.collect()
+    alive = sum(ref() is not None for ref in made)
+    assert alive <= prepared._TREES_PER_THREAD

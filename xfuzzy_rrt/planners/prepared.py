@@ -52,7 +52,35 @@ def pooled_tree(capacity: int, limits_deg: np.ndarray) -> TreeArena:
 
 def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[TreeArena, ...]:
     """``count`` distinct trees as :func:`pooled_tree` gives one (Fuzzy-RRT-Connect's start and
-    goal trees: ``count=2``), kept as one pool entry and found with one look-up."""
+    goal trees: ``count=2``), kept as one pool entry and found with one look-up.
+
+    The look-up is by the limits array's identity first: every plan of a scenario passes the
+    same array (:func:`scenario_arrays`), and hashing its bytes, ``asarray`` and the LRU's
+    bookkeeping cost ~19 us of a call that starts with cold caches (27.5 against 8.6 us;
+    README, "Against tuned peers", twelfth session), for every planner. The entry keeps the
+    array, so its identity cannot be taken by another array while it is remembered; like the
+    set-ups that hold the same arrays (:mod:`.setup_memo`), it relies on nobody writing into a
+    scenario's arrays."""
+    by_id = getattr(_local, "by_id", None)
+    if by_id is None:
+        by_id = _local.by_id = {}
+    id_key = (capacity, id(limits_deg), count)
+    hit = by_id.get(id_key)
+    if hit is not None and hit[0] is limits_deg:
+        return hit[1]
+    trees = _pooled_by_value(capacity, limits_deg, count)
+    if len(by_id) >= _IDENTITIES_PER_THREAD:
+        by_id.clear()
+    by_id[id_key] = (limits_deg, trees)
+    return trees
+
+
+#: Identity look-ups kept per thread (each holds a pooled entry and a limits array alive).
+_IDENTITIES_PER_THREAD = 8
+
+
+def _pooled_by_value(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[TreeArena, ...]:
+    """The pool proper, keyed by the limits' values (LRU of :data:`_TREES_PER_THREAD`)."""
     limits = np.asarray(limits_deg, dtype=np.float64)
     key = (int(capacity), limits.shape, limits.tobytes(), int(count))
     pool = getattr(_local, "trees", None)
@@ -63,6 +91,9 @@ def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[Tre
         hit = pool[key] = tuple(make_tree_arena(int(capacity), limits) for _ in range(count))
         while len(pool) > _TREES_PER_THREAD:
             pool.popitem(last=False)
+            # the identity look-ups may name the evicted trees: forget them all, so that no
+            # more than the pool's trees are ever kept alive
+            getattr(_local, "by_id", {}).clear()
         return hit
     pool.move_to_end(key)
     return hit

@@ -16,6 +16,10 @@ When a remembered set-up is used:
 - the caller checks that the rulebook it resolves now is the very object the set-up was
   built for (an edited rulebook directory loads as a new object: ``load_rulebook_cached``).
 
+A call that passes the very same scenario, setting and loaded-rulebook objects as one of the
+planner's last few finds that set-up without building the key (:func:`last_call`): the loop
+case, where building the key was most of the look-up's cost.
+
 Errors are never remembered: only a set-up whose checks all passed is stored, so a call with
 bad inputs runs the checks and raises the same one-line error every time. The memo is bounded
 (:data:`MAX_ENTRIES`, oldest dropped first; an entry also goes when its scenario does) and shared by threads; set-ups are immutable, and

@@ -395,20 +395,16 @@ def test_a_results_params_are_its_own_not_the_remembered_set_ups(scenarios, fres
 
 def test_a_loop_passing_the_same_objects_finds_its_set_up_without_building_a_key(
         scenarios, fresh_memo, monkeypatch):
-    from xfuzzy_rrt.planners import connect as connect_mod
-    from xfuzzy_rrt.planners import fuzzy_rrt as fuzzy_mod
-    from xfuzzy_rrt.planners import rrt as rrt_mod
     from xfuzzy_rrt.planners.api import load_shipped_default, load_tuned_rrt
 
     s = scenarios[0]
-    three = dataclasses.replace(s, name="another")  # planned in between: several kept per planner
+    other = dataclasses.replace(s, name="another")  # planned in between: several kept per planner
     calls = [("fuzzy-rrt", load_shipped_default()), ("rrt:tuned", load_tuned_rrt()),
              ("rrt", None)]
     first = [plan_scenario(s, planner, rulebook=given, seed=0, max_iter=300)
              for planner, given in calls]
-    plan_scenario(three, "rrt", seed=0, max_iter=300)
-    for mod in (rrt_mod, fuzzy_mod, connect_mod):
-        monkeypatch.setattr(mod, "exact", lambda v: pytest.fail("a key was built"))
+    plan_scenario(other, "rrt", seed=0, max_iter=300)
+    monkeypatch.setattr(setup_memo, "exact", lambda v: pytest.fail("a key was built"))
     for k in range(3):  # rrt and rrt:tuned in turn: both still found
         for (planner, given), was in zip(calls, first):
             again = plan_scenario(s, planner, rulebook=given, seed=0, max_iter=300)
@@ -417,13 +413,11 @@ def test_a_loop_passing_the_same_objects_finds_its_set_up_without_building_a_key
 
 def test_equal_settings_in_other_objects_take_the_key_and_find_the_same_set_up(
         scenarios, fresh_memo, monkeypatch):
-    from xfuzzy_rrt.planners import rrt as rrt_mod
-
     s = scenarios[0]
     plan_rrt(s, seed=0, max_iter=300, step_deg=45.0)
     keys, stored = [], []
-    real_exact, real_remember = rrt_mod.exact, setup_memo.remember
-    monkeypatch.setattr(rrt_mod, "exact", lambda v: keys.append(v) or real_exact(v))
+    real_exact, real_remember = setup_memo.exact, setup_memo.remember
+    monkeypatch.setattr(setup_memo, "exact", lambda v: keys.append(v) or real_exact(v))
     monkeypatch.setattr(setup_memo, "remember", lambda *a: stored.append(a) or real_remember(*a))
     step = float("45." + "0")  # equal, another object
     plan_rrt(s, seed=0, max_iter=300, step_deg=step)
@@ -434,12 +428,10 @@ def test_equal_settings_in_other_objects_take_the_key_and_find_the_same_set_up(
 
 def test_a_rulebook_directory_is_resolved_every_call_not_matched_by_identity(
         scenarios, rulebook_copy, fresh_memo, monkeypatch):
-    from xfuzzy_rrt.planners import fuzzy_rrt as fuzzy_mod
-
     root, _hashed = rulebook_copy
     s = scenarios[0]
     plan_fuzzy_rrt(s, root, seed=0, max_iter=300)
-    monkeypatch.setattr(fuzzy_mod, "last_call", lambda *a: pytest.fail("matched by identity"))
+    monkeypatch.setattr(setup_memo, "last_call", lambda *a: pytest.fail("matched by identity"))
     plan_fuzzy_rrt(s, root, seed=0, max_iter=300)
     plan_fuzzy_rrt(s, None, seed=0, max_iter=300)
 

@@ -100,8 +100,7 @@ from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.planners.prepared import pooled_trees, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import (exact, keep_last, last_call, remembered,
-                                              rulebook_token)
+from xfuzzy_rrt.planners.setup_memo import set_up
 from xfuzzy_rrt.planners.trace_record import TraceArrays, idle_buffers
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
@@ -444,20 +443,8 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
                clearance_m) -> _Setup:
     """:func:`_prepare`, remembered per scenario object and settings while the rulebook
     resolves to the same object (a call without a time budget or a trace)."""
-    loaded = hasattr(rulebook, "compiled")  # a directory or None must be resolved again
-    settings = (rulebook, max_iter, min_step_deg, margin, clearance_m)
-    if loaded:
-        setup = last_call(PLANNER, scenario, settings)
-        if setup is not None:
-            return setup
-    key = (PLANNER, id(scenario), rulebook_token(rulebook), exact(max_iter),
-           exact(min_step_deg), exact(margin), exact(clearance_m))
-    setup = remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter,
-                                                       min_step_deg, margin, clearance_m, None),
-                       rulebook, _resolve_rulebook)
-    if loaded:
-        keep_last(PLANNER, scenario, settings, setup)
-    return setup
+    return set_up(PLANNER, scenario, _prepare,
+                  (rulebook, max_iter, min_step_deg, margin, clearance_m), _resolve_rulebook)
 
 
 def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,

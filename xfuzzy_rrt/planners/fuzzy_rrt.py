@@ -77,8 +77,7 @@ from xfuzzy_rrt.planners.trace_record import (
     record_iteration,
 )
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import (exact, keep_last, last_call, remembered,
-                                              rulebook_token)
+from xfuzzy_rrt.planners.setup_memo import set_up
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
@@ -375,20 +374,8 @@ def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
                clearance_m) -> _Setup:
     """:func:`_prepare`, remembered per scenario object and settings while the rulebook
     resolves to the same object (a call without a time budget or a trace)."""
-    loaded = hasattr(rulebook, "compiled")  # a directory or None must be resolved again
-    settings = (rulebook, max_iter, min_step_deg, margin, clearance_m)
-    if loaded:
-        setup = last_call("fuzzy-rrt", scenario, settings)
-        if setup is not None:
-            return setup
-    key = ("fuzzy-rrt", id(scenario), rulebook_token(rulebook), exact(max_iter),
-           exact(min_step_deg), exact(margin), exact(clearance_m))
-    setup = remembered(key, scenario, lambda: _prepare(scenario, rulebook, max_iter,
-                                                       min_step_deg, margin, clearance_m, None),
-                       rulebook, _resolve_rulebook)
-    if loaded:
-        keep_last("fuzzy-rrt", scenario, settings, setup)
-    return setup
+    return set_up("fuzzy-rrt", scenario, _prepare,
+                  (rulebook, max_iter, min_step_deg, margin, clearance_m), _resolve_rulebook)
 
 
 def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: int = 10_000,

@@ -27,7 +27,7 @@ from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_resu
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
-from xfuzzy_rrt.planners.setup_memo import exact, keep_last, last_call, remembered
+from xfuzzy_rrt.planners.setup_memo import set_up
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
@@ -109,16 +109,8 @@ def _prepare(scenario: Scenario, max_iter, step_deg, goal_bias, margin, clearanc
 def _setup_for(scenario: Scenario, max_iter, step_deg, goal_bias, margin,
                clearance_m) -> _Setup:
     """:func:`_prepare`, remembered per scenario object and settings (no time budget)."""
-    settings = (max_iter, step_deg, goal_bias, margin, clearance_m)
-    setup = last_call("rrt", scenario, settings)
-    if setup is not None:
-        return setup
-    key = ("rrt", id(scenario), exact(max_iter), exact(step_deg), exact(goal_bias),
-           exact(margin), exact(clearance_m))
-    setup = remembered(key, scenario, lambda: _prepare(scenario, max_iter, step_deg, goal_bias,
-                                                       margin, clearance_m, None))
-    keep_last("rrt", scenario, settings, setup)
-    return setup
+    return set_up("rrt", scenario, _prepare,
+                  (max_iter, step_deg, goal_bias, margin, clearance_m))
 
 
 def plan_rrt(scenario: Scenario, seed: int = 0, max_iter: int = DEFAULT_MAX_ITER,

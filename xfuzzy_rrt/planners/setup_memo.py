@@ -160,6 +160,34 @@ def keep_last(site: str, scenario: Any, settings: tuple, setup: Any) -> None:
     _last[site] = [(ref, settings, setup), *_last.get(site, ())][:LAST_PER_SITE]
 
 
+def set_up(site: str, scenario: Any, prepare: Callable[..., Any], settings: tuple,
+           resolve: Callable[[Any], Any] | None = None) -> Any:
+    """``prepare(scenario, *settings, None)`` (a planner's checks without a time budget),
+    remembered: what every planner's call asks for its set-up, in one place.
+
+    A call that passes the very objects of one of *site*'s last calls finds it without a key
+    (:func:`last_call`); otherwise the exact key -- *site*, the scenario's ``id`` and each
+    setting through :func:`exact` -- is looked up (:func:`remembered`). With ``resolve``, the
+    first setting is the rulebook argument: it goes into the key as :func:`rulebook_token`, and
+    only a loaded rulebook is matched by identity (a directory or ``None`` must be resolved
+    again)."""
+    rulebook = settings[0] if resolve is not None else None
+    by_identity = resolve is None or hasattr(rulebook, "compiled")
+    if by_identity:
+        setup = last_call(site, scenario, settings)
+        if setup is not None:
+            return setup
+    if resolve is None:
+        key = (site, id(scenario), *(exact(v) for v in settings))
+    else:
+        key = (site, id(scenario), rulebook_token(rulebook), *(exact(v) for v in settings[1:]))
+    setup = remembered(key, scenario, lambda: prepare(scenario, *settings, None), rulebook,
+                       resolve)
+    if by_identity:
+        keep_last(site, scenario, settings, setup)
+    return setup
+
+
 def clear() -> None:
     """Forget every set-up (tests; nothing else needs it)."""
     _memo.clear()

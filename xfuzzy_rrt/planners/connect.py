@@ -135,13 +135,14 @@ def reversed_problem(P):
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
+def connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
                    TR, grown, connect_nodes, counts):
     """Run Fuzzy-RRT-Connect; return ``(success, iterations, junction node in TA, junction
     node in TB)`` (-1, -1 on failure). The two junction nodes hold the same configuration.
 
-    ``P`` is the problem, ``PR`` the same problem with start and goal swapped (the goal tree's
-    view: its extension joins the start directly when it can); ``TA``/``TB`` the empty start
+    ``P`` is the problem; the goal tree sees it with start and goal swapped
+    (:func:`reversed_problem`, built in the loop: its extension joins the start directly when
+    it can); ``TA``/``TB`` the empty start
     and goal trees. With ``record`` true, row ``it - 1`` of ``TR``, ``grown`` and
     ``connect_nodes`` describes iteration ``it``. ``counts[0]`` receives the number of
     extensions attempted. ``stop[0] != 0`` ends the run. ``scale``: Euclidean degrees per
@@ -152,7 +153,7 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step
     dof = P.start.shape[0]
     # an uncounted loop (README, "No reference counting in the loops") borrows these buffers
     return _connect_loop(
-        P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record, TR, grown,
+        P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record, TR, grown,
         connect_nodes, counts, np.empty(4, dtype=np.uint64), np.empty(4, dtype=np.float64),
         np.empty(n_out, dtype=np.float64), np.empty(n_out, dtype=np.float64),
         np.empty((n_out, MAX_FIRED), dtype=np.int32),
@@ -162,12 +163,16 @@ def connect_kernel(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
-def _connect_loop(P, PR, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
+def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
                   TR, grown, connect_nodes, counts, state, x, y, ys, dummy_rule, dummy_w, box,
                   vecs, current, reject):
     """:func:`connect_kernel`'s loop, given its scratch buffers (``vecs``: one row each for
     the sample, ``e``, the near and new configurations of both trees and the target)."""
     seed_state(seed, state)
+    # Built here, not passed in: the loop chooses between P and PR every iteration, and with
+    # both made from the same arrays in this function the compiler chooses only the start and
+    # the goal (passed in, every field of both records was chosen, every iteration).
+    PR = reversed_problem(P)
     n_out = knots.shape[0]
     dof = P.start.shape[0]
     sample = vecs[0]
@@ -378,8 +383,8 @@ def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots
                   min_step, stop, record, tr, grown, connect_nodes):
     """:func:`connect_kernel` with the problem and trace bundles as *plain* tuples and the two
     trees as their arenas, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the
-    goal tree's view of the problem is built here (:func:`reversed_problem`), not unboxed a
-    second time. Returns the kernel's four values and the number of extensions attempted.
+    goal tree's view of the problem is built in the kernel's loop (:func:`reversed_problem`),
+    not unboxed a second time. Returns the kernel's four values and the number of extensions attempted.
 
     ``tr`` ``None`` (a run that records nothing; ``grown`` and ``connect_nodes`` are then
     ``None`` too): the idle one-row buffers are made here
@@ -397,7 +402,7 @@ def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots
         connected = connect_nodes
     counts = np.zeros(1, dtype=np.int64)
     ok, it, last_a, last_b = connect_kernel(
-        P, reversed_problem(P), emptied_tree_in(block_a, layout_a),
+        P, emptied_tree_in(block_a, layout_a),
         emptied_tree_in(block_b, layout_b), seed, max_iter, knots, consts, scale, min_step, stop,
         record, TR, tree_of_row, connected, counts)
     return ok, it, last_a, last_b, counts[0]

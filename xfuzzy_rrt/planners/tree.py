@@ -334,14 +334,23 @@ def _select(nodes, perm, lo, hi, k, axis):
             return
 
 
-@nb.njit(cache=True, nogil=True, _nrt=False)
+@nb.njit(cache=True, nogil=True, inline="always")
 def _kd_build(T, n):
     """Balanced k-d tree over nodes ``0 .. n-1``: median splits along the range's widest axis,
-    down to buckets of at most ``KD_LEAF`` nodes."""
-    dof = T.nodes.shape[1]
+    down to buckets of at most ``KD_LEAF`` nodes (:func:`_kd_build_arrays` on ``T``'s arrays)."""
+    _kd_build_arrays(T.nodes, T.kd_perm, T.kd_axis, T.kd_stack, T.meta, n)
+
+
+@nb.njit(cache=True, nogil=True, _nrt=False)
+def _kd_build_arrays(nodes, kd_perm, kd_axis, kd_stack, meta, n):
+    """:func:`_kd_build` given the arrays it touches, not the whole tree record. Why: a record
+    passed to a compiled call travels as every one of its arrays (~130 machine words), and a
+    loop that chooses between two trees (Fuzzy-RRT-Connect's) then has to choose all of them,
+    every iteration, just in case this rare call happens."""
+    dof = nodes.shape[1]
     for i in range(n):
-        T.kd_perm[i] = i
-    stack = T.kd_stack
+        kd_perm[i] = i
+    stack = kd_stack
     stack[0, 0] = 0
     stack[0, 1] = n
     stack[0, 2] = 0
@@ -361,7 +370,7 @@ def _kd_build(T, n):
             a_min = np.inf
             a_max = -np.inf
             for k in range(lo, hi):
-                v = T.nodes[T.kd_perm[k], j]
+                v = nodes[kd_perm[k], j]
                 if v < a_min:
                     a_min = v
                 if v > a_max:
@@ -369,8 +378,8 @@ def _kd_build(T, n):
             if a_max - a_min > widest:
                 widest = a_max - a_min
                 axis = j
-        _select(T.nodes, T.kd_perm, lo, hi, mid, axis)
-        T.kd_axis[mid] = axis
+        _select(nodes, kd_perm, lo, hi, mid, axis)
+        kd_axis[mid] = axis
         if mid + 1 < hi:
             stack[top, 0] = mid + 1
             stack[top, 1] = hi
@@ -381,12 +390,21 @@ def _kd_build(T, n):
             stack[top, 1] = mid
             stack[top, 2] = d + 1
             top += 1
-    T.meta[KD_N] = n
+    meta[KD_N] = n
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _kd_nearest(T, q):
+    """Exact nearest node: k-d tree search, then the buffer (lowest index on ties)
+    (:func:`_kd_nearest_arrays` on ``T``'s arrays)."""
+    return _kd_nearest_arrays(T.nodes, T.kd_perm, T.kd_axis, T.kd_stack, T.kd_stack_lb,
+                              T.kd_off, T.meta, q)
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
-def _kd_nearest(T, q):
-    """Exact nearest node: k-d tree search, then the buffer (lowest index on ties).
+def _kd_nearest_arrays(nodes, kd_perm, kd_axis, kd_stack, kd_stack_lb, kd_off, meta, q):
+    """:func:`_kd_nearest` given the arrays it touches, not the whole tree record (why: see
+    :func:`_kd_build_arrays`).
 
     A range is skipped when a lower bound of the squared distance from ``q`` to its cell
     exceeds the best found: the sum over axes of the squared offset from ``q`` to the cell
@@ -395,15 +413,14 @@ def _kd_nearest(T, q):
     a node's distance sum their terms in different orders) can never prune a node as close as
     the best: only the speed depends on the bound, never the answer.
     """
-    nodes = T.nodes
     dof = q.shape[0]
     best_d2 = np.inf
     best_i = -1
     visits = 0
-    n_kd = T.meta[KD_N]
-    stack = T.kd_stack
-    lbs = T.kd_stack_lb
-    off = T.kd_off
+    n_kd = meta[KD_N]
+    stack = kd_stack
+    lbs = kd_stack_lb
+    off = kd_off
     cur = KD_STACK  # the row of ``off`` holding the current range's offsets
     top = 0
     if n_kd > 0:
@@ -425,7 +442,7 @@ def _kd_nearest(T, q):
         while lo < hi and lb * KD_SLACK <= best_d2:
             if hi - lo <= KD_LEAF:
                 for k in range(lo, hi):
-                    i = T.kd_perm[k]
+                    i = kd_perm[k]
                     d2 = _d2(nodes, i, q)
                     if d2 < best_d2 or (d2 == best_d2 and i < best_i):
                         best_d2 = d2
@@ -433,13 +450,13 @@ def _kd_nearest(T, q):
                 visits += hi - lo
                 break
             mid = (lo + hi) // 2
-            i = T.kd_perm[mid]
+            i = kd_perm[mid]
             d2 = _d2(nodes, i, q)
             visits += 1
             if d2 < best_d2 or (d2 == best_d2 and i < best_i):
                 best_d2 = d2
                 best_i = i
-            axis = T.kd_axis[mid]
+            axis = kd_axis[mid]
             diff = q[axis] - nodes[i, axis]
             old = off[cur, axis]
             far_lb = lb - old * old + diff * diff
@@ -460,13 +477,13 @@ def _kd_nearest(T, q):
                 hi = mid
             else:
                 lo = mid + 1
-    n = T.meta[N_NODES]
+    n = meta[N_NODES]
     for i in range(n_kd, n):
         d2 = _d2(nodes, i, q)
         if d2 < best_d2 or (d2 == best_d2 and i < best_i):
             best_d2 = d2
             best_i = i
-    T.meta[NN_VISITS] += visits + (n - n_kd)
+    meta[NN_VISITS] += visits + (n - n_kd)
     return best_i
 
 

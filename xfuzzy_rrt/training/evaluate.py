@@ -27,7 +27,7 @@ import numpy as np
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy import semantics as _sem
-from xfuzzy_rrt.planners.connect import connect_kernel, reversed_problem
+from xfuzzy_rrt.planners.connect import connect_kernel
 from xfuzzy_rrt.planners.fuzzy_rrt import GOAL_FRAME, MIN_STEP_DEG, fuzzy_rrt_kernel
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.trace_record import make_trace
@@ -196,7 +196,6 @@ def connect_population_measured(P, TA, TB, knots_b, consts_b, seeds, max_iter, s
     n_ind = knots_b.shape[0]
     n_seeds = seeds.shape[0]
     out = np.empty((n_ind, n_seeds, 2), dtype=np.int64)
-    PR = reversed_problem(P)
     meta_a = TA.meta.copy()
     meta_b = TB.meta.copy()
     record = n_seeds < 0  # a run-time False: see run_population_measured
@@ -206,7 +205,7 @@ def connect_population_measured(P, TA, TB, knots_b, consts_b, seeds, max_iter, s
             reset_tree(TB, meta_b)
             work0 = P.work[0]
             ok, iterations, _, _ = connect_kernel(
-                P, PR, TA, TB, seeds[r], max_iter, knots_b[p], consts_b[p], scale, min_step,
+                P, TA, TB, seeds[r], max_iter, knots_b[p], consts_b[p], scale, min_step,
                 stop, record, TR, grown, connect_nodes, counts)
             out[p, r, 0] = iterations if ok else -1
             out[p, r, 1] = P.work[0] - work0 + TA.meta[NN_VISITS] + TB.meta[NN_VISITS]

@@ -679,14 +679,19 @@ def edge_free_two_link(P, qa_deg, qb_deg, margin, ca0, ca1, cb0, cb1, probe=True
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has_obstacles,
-               has_self):
+               has_self, rows, r):
     """One stop of :func:`edge_free` at ``q(s)``: ``(finite, cmin, ds)``, the smallest clearance
     of any pair of bodies there and the safe advance it buys (``min (c - clear) / M`` over the
     pairs). ``finite`` is False when a clearance came out infinite or NaN with something to
-    touch: the arithmetic overflowed, and an infinite step would skip the segment."""
+    touch: the arithmetic overflowed, and an infinite step would skip the segment.
+
+    With ``r >= 0`` every value measured is also written to ``rows[r, 1:]`` in the order
+    measured (each link against the obstacles, then the link pairs of two arms, then those of
+    one arm: :func:`stop_width`), which is the order :func:`_stored_stop` reads them back in."""
     obstacles = P.obstacles
     cmin = np.inf
     ds = np.inf
+    col = 1 + P.links.shape[0]  # the next link pair's column (links take 1 .. L)
     for a in range(n_arms):
         x = P.bases[a, 0]
         y = P.bases[a, 1]
@@ -703,6 +708,8 @@ def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has
                 seg[k, 3] = ny
             if has_obstacles:
                 ck = _link_clearance(x, y, nx, ny, P.radii[a], obstacles)
+                if r >= 0:
+                    rows[r, 1 + k] = ck
                 if not ck < np.inf:
                     return False, cmin, ds
                 if ck < cmin:
@@ -724,6 +731,9 @@ def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has
                         d = segment_segment_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
                                                  seg[m, 0], seg[m, 1], seg[m, 2],
                                                  seg[m, 3]) - rr
+                        if r >= 0:
+                            rows[r, col] = d
+                        col += 1
                         if not d < np.inf:
                             return False, cmin, ds
                         if d < cmin:
@@ -740,6 +750,9 @@ def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has
                 for m in range(k + 2, P.arm_first[a + 1]):
                     d = segment_segment_dist(seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
                                              seg[m, 0], seg[m, 1], seg[m, 2], seg[m, 3]) - rr
+                    if r >= 0:
+                        rows[r, col] = d
+                    col += 1
                     if not d < np.inf:
                         return False, cmin, ds
                     if d < cmin:
@@ -750,6 +763,113 @@ def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has
                         if step < ds:
                             ds = step
     return True, cmin, ds
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _stored_stop(P, rows, r, mks, msf, clear, n_arms, has_obstacles, has_self):
+    """:func:`_edge_stop` from the values it wrote to ``rows[r]`` at the same configuration:
+    the same ``(finite, cmin, ds)`` bit for bit (the same floats, met in the same order, go
+    through the same comparisons and divisions), without the forward kinematics and the
+    distances. Only for a row whose column 0 is 1.0 (complete: :func:`node_stop_into`)."""
+    cmin = np.inf
+    ds = np.inf
+    if has_obstacles:
+        for k in range(P.links.shape[0]):
+            ck = rows[r, 1 + k]
+            if not ck < np.inf:
+                return False, cmin, ds
+            if ck < cmin:
+                cmin = ck
+            mk = mks[k]
+            if mk > 0.0:
+                step = (ck - clear) / mk
+                if step < ds:
+                    ds = step
+    col = 1 + P.links.shape[0]
+    if n_arms > 1:
+        for a in range(n_arms):
+            for b in range(a + 1, n_arms):
+                for k in range(P.arm_first[a], P.arm_first[a + 1]):
+                    mka = mks[k]
+                    for m in range(P.arm_first[b], P.arm_first[b + 1]):
+                        d = rows[r, col]
+                        col += 1
+                        if not d < np.inf:
+                            return False, cmin, ds
+                        if d < cmin:
+                            cmin = d
+                        mkm = mka + mks[m]
+                        if mkm > 0.0:
+                            step = (d - clear) / mkm
+                            if step < ds:
+                                ds = step
+    if has_self:
+        for a in range(n_arms):
+            for k in range(P.arm_first[a], P.arm_first[a + 1]):
+                for m in range(k + 2, P.arm_first[a + 1]):
+                    d = rows[r, col]
+                    col += 1
+                    if not d < np.inf:
+                        return False, cmin, ds
+                    if d < cmin:
+                        cmin = d
+                    mkm = msf[k, m]
+                    if mkm > 0.0:
+                        step = (d - clear) / mkm
+                        if step < ds:
+                            ds = step
+    return True, cmin, ds
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def stop_width(P):
+    """Columns of one configuration's stop record (:func:`node_stop_into`): a flag (1.0: the
+    record is complete), each link's clearance from the obstacles, each link pair's distance
+    (pairs of two arms, then non-adjacent pairs of one arm, in :func:`_edge_stop`'s order)."""
+    return 1 + P.links.shape[0] + n_link_pairs(P)
+
+
+@nb.njit(cache=True, nogil=True, _nrt=False)
+def stop_record_into(P, q_deg, seg, mks, msf, rows, r):
+    """Measure the stop record of ``q_deg`` into ``rows[r]`` (:func:`node_stop_into`) and return
+    ``(finite, cmin)``; column 0 becomes 1.0 only when the record is complete. Counts no work:
+    the stop it stands for counts where a check takes it (:func:`edge_free_rows`)."""
+    n_arms = P.arm_first.shape[0] - 1
+    has_self = has_self_pairs(P)
+    rows[r, 0] = np.nan
+    finite, cmin, _ = _edge_stop(P, q_deg, q_deg, 1.0, mks, msf, seg, 0.0, n_arms,
+                                 n_arms > 1 or has_self, P.obstacles.shape[0] > 0, has_self,
+                                 rows, r)
+    if finite:
+        rows[r, 0] = 1.0
+    return finite, cmin
+
+
+@nb.njit(cache=True, nogil=True, _nrt=False)
+def node_stop_into(P, q_deg, seg, mks, msf, rows, r):
+    """:func:`clearance_into` (the same value, the same work) that also keeps in ``rows[r]``
+    what an edge stop at ``q_deg`` measures (:func:`stop_width` columns), so that the certified
+    check of an edge that starts or ends at this configuration takes that stop from the record
+    (:func:`edge_free_rows`) instead of measuring it again.
+
+    Why: a planner checks a new node, then the edge to it, whose first stop is the node it
+    grows from (checked when it was added) and whose last stop is the new node itself; on
+    3-7 joints an extension measures ~4-8 stops, so these two are a large share of them. The
+    values are measured by :func:`_edge_stop` itself, at ``s = 1`` of the edge ``q -> q`` (the
+    last stop takes ``qb`` as given, as every edge's does); their minimum is
+    :func:`clearance_into`'s value (a minimum of the same floats). When one came out infinite
+    or NaN the record stays incomplete (column 0 NaN) and the value is measured as
+    :func:`clearance_into` measures it. ``seg``, ``mks`` and ``msf`` are the tree's scratch
+    (:func:`edge_free_into`'s; the advance a stop computes from ``mks``/``msf`` is not used
+    here, so their values do not matter).
+    """
+    finite, cmin = stop_record_into(P, q_deg, seg, mks, msf, rows, r)
+    P.work[0] += n_distance_pairs(P)
+    if finite:
+        return cmin
+    if _has_link_pairs(P):
+        return _clearance_with_pairs(P, q_deg, seg)
+    return _obstacle_clearance(P, q_deg)
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
@@ -791,8 +911,9 @@ def _edge_free(P, qa_deg, qb_deg, margin, probe):
     if n == 2 and P.arm_first.shape[0] == 2:  # one two-link arm: no buffers needed
         nan = np.nan
         return edge_free_two_link(P, qa_deg, qb_deg, margin, nan, nan, nan, nan, probe)[0]
-    return _edge_free_into(P, qa_deg, qb_deg, margin, probe, np.empty((n, 4)), np.empty(n),
-                           np.empty((n, n)))
+    seg = np.empty((n, 4))
+    return _edge_free_into(P, qa_deg, qb_deg, margin, probe, seg, np.empty(n), np.empty((n, n)),
+                           seg, -1, -1)
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
@@ -800,11 +921,22 @@ def edge_free_into(P, qa_deg, qb_deg, margin, seg, mks, msf):
     """:func:`edge_free` with its buffers given (``seg`` ``[L, 4]``, ``mks`` ``[L]``, ``msf``
     ``[L, L]``, ``L`` links in all; a tree's ``seg``/``mks``/``msf``): the planners' loops call
     it once per extension and allocate nothing. Same verdict, same work."""
-    return _edge_free_into(P, qa_deg, qb_deg, margin, True, seg, mks, msf)
+    return _edge_free_into(P, qa_deg, qb_deg, margin, True, seg, mks, msf, seg, -1, -1)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def edge_free_rows(P, qa_deg, qb_deg, margin, seg, mks, msf, rows, ra, rb):
+    """:func:`edge_free_into` given the stop records of its ends (:func:`node_stop_into`):
+    ``rows[ra]`` of ``qa`` and ``rows[rb]`` of ``qb`` (``-1``, or a record whose column 0 is
+    not 1.0: not known, measured). The first stop is ``qa`` bit for bit (``qa + 0 (qb - qa)``)
+    and the last takes ``qb`` itself, so a known end is taken from its record
+    (:func:`_stored_stop`). Same stops, same verdict, same ``P.work`` (a stop counts whether
+    measured or taken from a record, as in :func:`edge_free_two_link`)."""
+    return _edge_free_into(P, qa_deg, qb_deg, margin, True, seg, mks, msf, rows, ra, rb)
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
-def _edge_free_into(P, qa_deg, qb_deg, margin, probe, seg, mks, msf):
+def _edge_free_into(P, qa_deg, qb_deg, margin, probe, seg, mks, msf, rows, ra, rb):
     n_arms = P.arm_first.shape[0] - 1
     if n_arms == 1 and P.links.shape[0] == 2:  # one two-link arm: no arrays needed
         nan = np.nan
@@ -832,11 +964,20 @@ def _edge_free_into(P, qa_deg, qb_deg, margin, probe, seg, mks, msf):
     per_stop = n_distance_pairs(P)
     s = 0.0
     sched = probe_start(probe)
+    known_a = ra >= 0 and rows[ra, 0] == 1.0
+    known_b = rb >= 0 and rows[rb, 0] == 1.0
     while True:
         P.work[0] += per_stop
         # Per-pair clearance at q(s) and the safe advance it buys.
-        finite, cmin, ds = _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms,
-                                      need_seg, has_obstacles, has_self)
+        if s >= 1.0 and known_b:
+            finite, cmin, ds = _stored_stop(P, rows, rb, mks, msf, clear, n_arms,
+                                            has_obstacles, has_self)
+        elif s == 0.0 and known_a:
+            finite, cmin, ds = _stored_stop(P, rows, ra, mks, msf, clear, n_arms,
+                                            has_obstacles, has_self)
+        else:
+            finite, cmin, ds = _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms,
+                                          need_seg, has_obstacles, has_self, rows, -1)
         if not finite:
             return False
         if cmin <= margin:
@@ -847,7 +988,7 @@ def _edge_free_into(P, qa_deg, qb_deg, margin, probe, seg, mks, msf):
         if at > 0.0:
             P.work[0] += per_stop
             finite, c_at, _ = _edge_stop(P, qa_deg, qb_deg, at, mks, msf, seg, clear, n_arms,
-                                         need_seg, has_obstacles, has_self)
+                                         need_seg, has_obstacles, has_self, rows, -1)
             if finite and c_at <= clear:
                 return False
             sched = probe_missed(sched)

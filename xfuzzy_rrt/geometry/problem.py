@@ -50,6 +50,22 @@ class Problem(NamedTuple):
     work: np.ndarray
 
 
+def stop_record_width(arm_first) -> int:
+    """Columns of a tree node's stop record for arms split as ``arm_first`` (joints in all:
+    ``arm_first[-1]``): what :func:`~xfuzzy_rrt.geometry.collision.stop_width` computes in
+    compiled code (a flag, one per link, one per link pair that can touch), for the Python
+    side that makes the trees (:func:`~xfuzzy_rrt.planners.tree.make_tree`); 0 with two joints
+    in all, where a two-link arm keeps its own per-link values and two one-link arms keep
+    none."""
+    sizes = [int(n) for n in np.diff(np.asarray(arm_first, dtype=np.int64))]
+    dof = sum(sizes)
+    if dof <= 2:
+        return 0
+    pairs = sum((n - 1) * (n - 2) // 2 for n in sizes if n >= 3)
+    pairs += sum(a * b for i, a in enumerate(sizes) for b in sizes[i + 1:])
+    return 1 + dof + pairs
+
+
 def new_work_counter() -> np.ndarray:
     """A fresh zeroed ``work`` counter (``np.int64``, length 1)."""
     return np.zeros(1, dtype=np.int64)

@@ -14,6 +14,8 @@ described in ``docs/scenarios.md``.
 
 from __future__ import annotations
 
+import functools
+
 import math
 import re
 import tomllib
@@ -154,6 +156,15 @@ class ScenarioArrays:
     @property
     def dof(self) -> int:
         return int(self.links.shape[0])
+
+    @functools.cached_property
+    def stop_width(self) -> int:
+        """Columns of a tree node's stop record on this problem, what planners make their
+        trees with (:func:`~xfuzzy_rrt.geometry.problem.stop_record_width`); worked out once
+        (every plan call reads it)."""
+        from xfuzzy_rrt.geometry.problem import stop_record_width
+
+        return stop_record_width(self.arm_first)
 
     @classmethod
     def from_scenario(cls, s: Scenario) -> "ScenarioArrays":

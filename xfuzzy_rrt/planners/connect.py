@@ -473,7 +473,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
     work = new_work_counter()  # one count for both directions
     problem = (*setup.forward_head, work)
-    arena_a, arena_b = pooled_trees(tree_capacity(max_iter), a.limits_deg, 2)
+    arena_a, arena_b = pooled_trees(tree_capacity(max_iter), a.limits_deg, 2, a.stop_width)
     ta, tb = arena_a.tree, arena_b.tree
     if trace:
         buffers = make_trace(max_iter, a.dof, knots.shape[0], 1)

@@ -16,9 +16,12 @@ import numpy as np
 
 from xfuzzy_rrt.geometry.collision import (
     clearance_into,
-    edge_free_into,
+    edge_free_rows,
     edge_free_two_link,
     n_distance_pairs,
+    node_stop_into,
+    stop_record_into,
+    stop_width,
     two_link_clearances,
     within_limits,
 )
@@ -29,7 +32,7 @@ from xfuzzy_rrt.planners.result import (
     NO_PROGRESS,
     NODE_IN_COLLISION,
 )
-from xfuzzy_rrt.planners.tree import add_node
+from xfuzzy_rrt.planners.tree import N_NODES, add_node
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -64,12 +67,24 @@ def extend(P, T, near, sample, step, q_near, q_new):
         return NODE_IN_COLLISION, -1
     if dof == 2 and P.arm_first.shape[0] == 2:
         return _extend_two_link(P, T, near, step, q_near, q_new)
-    c_new = clearance_into(P, q_new, T.seg)
+    # Stop records (a tree made with ``stops = stop_width(P)``: make_tree): the new node's is
+    # measured by its node check into the row it will take, and the edge takes its two ends
+    # from the near node's record and that one instead of measuring them again.
+    rows = T.link_clear
+    n = T.meta[N_NODES]
+    # (never into the goal's row: a full tree, which no planner extends, measures as before)
+    records = rows.shape[1] == stop_width(P) and n < rows.shape[0] - 1
+    if records:
+        c_new = node_stop_into(P, q_new, T.seg, T.mks, T.msf, rows, n)
+    else:
+        c_new = clearance_into(P, q_new, T.seg)
     if not c_new > P.margin:
         return NODE_IN_COLLISION, -1
-    if not edge_free_into(P, q_near, q_new, P.margin, T.seg, T.mks, T.msf):
+    ra = near if records else -1
+    rb = n if records else -1
+    if not edge_free_rows(P, q_near, q_new, P.margin, T.seg, T.mks, T.msf, rows, ra, rb):
         return EDGE_BLOCKED, -1
-    k = add_node(T, q_new, near)
+    k = add_node(T, q_new, near)  # k == n: its record is already in place
     T.clear[k] = c_new
     at_goal = True
     g2 = 0.0
@@ -80,11 +95,18 @@ def extend(P, T, near, sample, step, q_near, q_new):
         g2 += gj * gj
     if at_goal:
         return GOAL_REACHED, k
-    if math.sqrt(g2) <= step and edge_free_into(P, q_new, P.goal, P.margin, T.seg, T.mks,
-                                                 T.msf):
-        g = add_node(T, P.goal, k)
-        T.clear[g] = np.nan
-        return GOAL_REACHED, g
+    if math.sqrt(g2) <= step:
+        rg = -1
+        if records:  # the goal's record, measured once per run into the last row
+            rg = rows.shape[0] - 1
+            if not rows[rg, 0] == 1.0:
+                stop_record_into(P, P.goal, T.seg, T.mks, T.msf, rows, rg)
+        if edge_free_rows(P, q_new, P.goal, P.margin, T.seg, T.mks, T.msf, rows, rb, rg):
+            g = add_node(T, P.goal, k)
+            T.clear[g] = np.nan
+            if records:
+                rows[g, 0] = np.nan  # no record measured at this index in this run
+            return GOAL_REACHED, g
     return ACCEPTED, k
 
 
@@ -135,7 +157,8 @@ def _extend_two_link(P, T, near, step, q_near, q_new):
 @nb.njit(cache=True, nogil=True, _nrt=False)
 def node_clearance(P, T, i):
     """``clearance_kernel(P, T.nodes[i])`` (same value, same work), keeping a two-link arm's
-    per-link values in ``T.link_clear`` for the edges that will leave node ``i``."""
+    per-link values, or any other arm's stop record (a tree with records: :func:`extend`), in
+    ``T.link_clear`` for the edges that will leave node ``i``."""
     q = T.nodes[i]
     if q.shape[0] == 2 and P.arm_first.shape[0] == 2:
         c0, c1 = two_link_clearances(P, q[0], q[1])
@@ -143,4 +166,6 @@ def node_clearance(P, T, i):
         T.link_clear[i, 0] = c0
         T.link_clear[i, 1] = c1
         return min(min(np.inf, c0), c1)
+    if T.link_clear.shape[1] == stop_width(P):  # and its stop record (extend)
+        return node_stop_into(P, q, T.seg, T.mks, T.msf, T.link_clear, i)
     return clearance_into(P, q, T.seg)

@@ -401,7 +401,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, mode, kernel = setup.knots, setup.consts, setup.mode, setup.kernel
     problem = (*setup.problem_head, new_work_counter())
-    arena = pooled_tree(max_iter + 2, a.limits_deg)
+    arena = pooled_tree(max_iter + 2, a.limits_deg, a.stop_width)
     tree, block, layout = arena.tree, arena.block, arena.layout
     # untraced: no buffers to unbox (the entry makes its idle ones)
     buffers = tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace else None

@@ -42,15 +42,17 @@ def scenario_arrays(scenario):
     return arrays
 
 
-def pooled_tree(capacity: int, limits_deg: np.ndarray) -> TreeArena:
-    """A tree for ``capacity`` nodes in ``limits_deg`` in one block (:mod:`.tree_arena`),
-    reused within this thread from one plan to the next (a result keeps copies, never the
-    tree's arrays), *not* emptied: the compiled entries empty it
+def pooled_tree(capacity: int, limits_deg: np.ndarray, stops: int = 0) -> TreeArena:
+    """A tree for ``capacity`` nodes in ``limits_deg`` in one block (:mod:`.tree_arena`), with
+    stop records of ``stops`` columns (:func:`~xfuzzy_rrt.planners.tree.make_tree`), reused
+    within this thread from one plan to the next (a result keeps copies, never the tree's
+    arrays), *not* emptied: the compiled entries empty it
     (:func:`~xfuzzy_rrt.planners.tree_arena.emptied_tree_in`)."""
-    return pooled_trees(capacity, limits_deg, 1)[0]
+    return pooled_trees(capacity, limits_deg, 1, stops)[0]
 
 
-def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[TreeArena, ...]:
+def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int,
+                 stops: int = 0) -> tuple[TreeArena, ...]:
     """``count`` distinct trees as :func:`pooled_tree` gives one (Fuzzy-RRT-Connect's start and
     goal trees: ``count=2``), kept as one pool entry and found with one look-up.
 
@@ -64,11 +66,11 @@ def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[Tre
     by_id = getattr(_local, "by_id", None)
     if by_id is None:
         by_id = _local.by_id = {}
-    id_key = (capacity, id(limits_deg), count)
+    id_key = (capacity, id(limits_deg), count, stops)
     hit = by_id.get(id_key)
     if hit is not None and hit[0] is limits_deg:
         return hit[1]
-    trees = _pooled_by_value(capacity, limits_deg, count)
+    trees = _pooled_by_value(capacity, limits_deg, count, stops)
     if len(by_id) >= _IDENTITIES_PER_THREAD:
         by_id.clear()
     by_id[id_key] = (limits_deg, trees)
@@ -79,16 +81,18 @@ def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[Tre
 _IDENTITIES_PER_THREAD = 8
 
 
-def _pooled_by_value(capacity: int, limits_deg: np.ndarray, count: int) -> tuple[TreeArena, ...]:
+def _pooled_by_value(capacity: int, limits_deg: np.ndarray, count: int,
+                     stops: int) -> tuple[TreeArena, ...]:
     """The pool proper, keyed by the limits' values (LRU of :data:`_TREES_PER_THREAD`)."""
     limits = np.asarray(limits_deg, dtype=np.float64)
-    key = (int(capacity), limits.shape, limits.tobytes(), int(count))
+    key = (int(capacity), limits.shape, limits.tobytes(), int(count), int(stops))
     pool = getattr(_local, "trees", None)
     if pool is None:
         pool = _local.trees = OrderedDict()
     hit = pool.get(key)
     if hit is None:
-        hit = pool[key] = tuple(make_tree_arena(int(capacity), limits) for _ in range(count))
+        hit = pool[key] = tuple(make_tree_arena(int(capacity), limits, int(stops))
+                                for _ in range(count))
         while len(pool) > _TREES_PER_THREAD:
             pool.popitem(last=False)
             # the identity look-ups may name the evicted trees: forget them all, so that no

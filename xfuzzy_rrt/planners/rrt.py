@@ -143,7 +143,7 @@ def plan_rrt_as(label: str, extra_params: dict | None, scenario: Scenario, seed:
     a, margin, params = setup.arrays, setup.margin, setup.params
     max_iter = int(params["max_iter"])
     problem = (*setup.problem_head, new_work_counter())
-    arena = pooled_tree(max_iter + 2, a.limits_deg)
+    arena = pooled_tree(max_iter + 2, a.limits_deg, a.stop_width)
     tree, block, layout = arena.tree, arena.block, arena.layout
     step, bias = float(params["step_deg"]), float(params["goal_bias"])
     recorded = dict(setup.recorded)

@@ -67,12 +67,16 @@ class TreeArrays(NamedTuple):
     #: each node's clearance (m) as measured when it was accepted (NaN where it was not:
     #: a goal joined by the connection step); planners read it instead of measuring again
     clear: np.ndarray
-    #: one two-link arm only (``[capacity + 1, 2]``; ``[1, 2]`` otherwise, unused): each node's
-    #: clearance per link, the values the certified edge check measures at an edge's ends, so
-    #: that an edge leaving or reaching a measured node does not measure it again
-    #: (:func:`xfuzzy_rrt.planners.extend.extend`). The last row holds the goal's. ``NaN`` in
-    #: column 0: not measured in this run (:func:`add_node` writes it for every new node, and
-    #: for the goal row when a run adds its root).
+    #: what the certified edge check measures at an edge's ends, per node, so that an edge
+    #: leaving or reaching a measured node does not measure it again
+    #: (:func:`xfuzzy_rrt.planners.extend.extend`); the last row holds the goal's. One two-link
+    #: arm: each node's clearance per link (``[capacity + 1, 2]``; ``NaN`` in column 0: not
+    #: measured in this run, which :func:`add_node` writes for every new node, and for the goal
+    #: row when a run adds its root). Any other arm, in a tree made with ``stops``: each
+    #: node's stop record (``[capacity + 1, stops]``,
+    #: :func:`~xfuzzy_rrt.geometry.collision.node_stop_into`; column 0 is 1.0 once complete,
+    #: written by the node check before the node is added; :func:`add_node` marks the root's
+    #: and the goal's rows not measured when a run adds its root). Otherwise ``[1, 2]``, unused.
     link_clear: np.ndarray
     #: two joints, grids of at most 64 x 64 cells (``[ncy + ncx]``; ``[1]`` otherwise, unused):
     #: occupied cells as bits, row ``y`` in ``occ[y]`` (bit ``x``) and column ``x`` in
@@ -107,8 +111,15 @@ KD_LEAF = 12
 KD_STACK = 128
 
 
-def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG) -> TreeArrays:
-    """Empty tree for ``capacity`` nodes in the joint box ``limits_deg`` (``[dof, 2]``)."""
+def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG,
+              stops: int = 0) -> TreeArrays:
+    """Empty tree for ``capacity`` nodes in the joint box ``limits_deg`` (``[dof, 2]``).
+
+    ``stops``: the width of one node's stop record for the problem it will grow in
+    (:func:`~xfuzzy_rrt.geometry.collision.stop_width`,
+    :attr:`~xfuzzy_rrt.geometry.scenario.ScenarioArrays.stop_width`; 0 for one two-link arm,
+    which keeps its per-link values instead). With 0, or a width that is not the problem's,
+    every edge measures both its ends (the same results, more time)."""
     limits_deg = np.asarray(limits_deg, dtype=np.float64)
     if limits_deg.ndim != 2 or limits_deg.shape[1] != 2 or limits_deg.shape[0] < 2:
         raise ValueError("the tree needs joint limits of shape [dof >= 2, 2]")
@@ -128,7 +139,8 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG)
         np.zeros((KD_STACK, 3), dtype=np.int64), np.zeros(KD_STACK, dtype=np.float64),
         np.zeros((KD_STACK + 1 if dof > 2 else 1, dof), dtype=np.float64),
         np.empty(capacity, dtype=np.float64),
-        np.full((capacity + 1 if dof == 2 else 1, 2), np.nan, dtype=np.float64),
+        np.full((capacity + 1, int(stops)) if stops > 0 else
+                (capacity + 1 if dof == 2 else 1, 2), np.nan, dtype=np.float64),
         np.zeros(ncy + ncx if dof == 2 and ncx <= 64 and ncy <= 64 else 1, dtype=np.uint64),
         np.zeros((dof, 4), dtype=np.float64), np.zeros(dof, dtype=np.float64),
         np.zeros((dof, dof), dtype=np.float64))
@@ -506,8 +518,13 @@ def add_node(T, q, parent_index):
         if T.occ.shape[0] > 1:
             T.occ[cy] |= np.uint64(1) << np.uint64(cx)
             T.occ[T.meta[NCY] + cx] |= np.uint64(1) << np.uint64(cy)
-    elif i + 1 > _brute_max(dof) and (i + 1 - T.meta[KD_N]) > max(32.0, 2.0 * math.sqrt(i + 1.0)):
-        _kd_build(T, i + 1)
+    else:
+        if i == 0 and T.link_clear.shape[0] > 1:  # a new run: no stop record measured yet
+            T.link_clear[0, 0] = np.nan
+            T.link_clear[T.link_clear.shape[0] - 1, 0] = np.nan
+        if i + 1 > _brute_max(dof) and (i + 1 - T.meta[KD_N]) > max(32.0,
+                                                                    2.0 * math.sqrt(i + 1.0)):
+            _kd_build(T, i + 1)
     return i
 
 

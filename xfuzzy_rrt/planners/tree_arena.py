@@ -48,9 +48,9 @@ class TreeArena(NamedTuple):
     layout: np.ndarray
 
 
-def make_tree_arena(capacity: int, limits_deg: np.ndarray) -> TreeArena:
+def make_tree_arena(capacity: int, limits_deg: np.ndarray, stops: int = 0) -> TreeArena:
     """:func:`~xfuzzy_rrt.planners.tree.make_tree`'s empty tree, moved into one block."""
-    fresh = make_tree(capacity, limits_deg)
+    fresh = make_tree(capacity, limits_deg, stops=stops)
     parts = list(fresh) + [fresh.meta.copy()]
     for name, arr, (dtype, ndim) in zip(TreeArrays._fields, fresh, FIELD_KINDS):
         if arr.dtype != dtype or arr.ndim != ndim:

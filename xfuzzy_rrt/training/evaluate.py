@@ -107,6 +107,13 @@ class TrainingProblem:
     def dof(self) -> int:
         return int(self.bundle.start.shape[0])
 
+    @property
+    def stop_width(self) -> int:
+        """Columns of its trees' stop records (:func:`~xfuzzy_rrt.planners.tree.make_tree`)."""
+        from xfuzzy_rrt.geometry.problem import stop_record_width
+
+        return stop_record_width(self.bundle.arm_first)
+
     @classmethod
     def from_scenario(cls, scenario) -> "TrainingProblem":
         from xfuzzy_rrt.geometry.clearance import planning_margin
@@ -146,7 +153,7 @@ def iterations_for(problems: list[TrainingProblem], knots_b: np.ndarray, consts_
     shape = (knots_b.shape[0], len(problems), seeds.shape[0]) + ((2,) if measure == "work" else ())
     out = np.empty(shape, dtype=np.int64)
     for s, pr in enumerate(problems):
-        tree = make_tree(int(max_iter) + 2, pr.limits)
+        tree = make_tree(int(max_iter) + 2, pr.limits, stops=pr.stop_width)
         # a plug-in's evaluation that only counts iterations keeps its 7-argument signature
         extra = (measure,) if measure != "iterations" else ()
         out[:, s] = population(pr, tree, knots_b, consts_b, mode, seeds, int(max_iter), *extra)
@@ -221,8 +228,8 @@ def connect_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, 
     from xfuzzy_rrt.planners.connect import tree_capacity
 
     cap = tree_capacity(max_iter)
-    ta = make_tree(cap, pr.limits)
-    tb = make_tree(cap, pr.limits)
+    ta = make_tree(cap, pr.limits, stops=pr.stop_width)
+    tb = make_tree(cap, pr.limits, stops=pr.stop_width)
     buffers = make_trace(1, pr.dof, knots_b.shape[1], 1)
     rows = (np.zeros(1, dtype=np.int8), np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
     # a work counter of this call's own (Dask threads share problem objects)
@@ -353,7 +360,7 @@ def rrt_runs(pr: TrainingProblem, seeds: np.ndarray, max_iter: int, step_deg: fl
     training baselines are medians of."""
     from xfuzzy_rrt.planners.rrt import rrt_kernel
 
-    tree = make_tree(int(max_iter) + 2, pr.limits)
+    tree = make_tree(int(max_iter) + 2, pr.limits, stops=pr.stop_width)
     meta0 = tree.meta.copy()
     stop = np.zeros(1, dtype=np.int64)
     bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))  # a counter of its own

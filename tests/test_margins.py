@@ -314,4 +314,10 @@ def test_path_min_clearance_agrees_with_the_dense_exact_oracle(case):
     assert ours.value_m >= lower - 1e-12
     assert ours.lower_bound_m <= ours.value_m
     at = oracle.clearance(np.array(ours.config_deg))[0]
-    assert at == pytest.approx(ours.value_m, abs=1e-9)
+    if ours.value_m < 0.0:
+        # a penetration between the oracle's samples (it sampled only clear configurations):
+        # the oracle's distances stop at 0 inside an obstacle (shapely), so at the
+        # configuration named it must see contact, and our signed depth at least as deep
+        assert at <= 1e-9 and ours.value_m <= at + 1e-9
+    else:
+        assert at == pytest.approx(ours.value_m, abs=1e-9)

@@ -55,8 +55,8 @@ def test_the_compiled_entries_empty_a_used_tree():
 
 
 def test_an_arena_refuses_a_tree_whose_fields_changed_kind(monkeypatch):
-    def changed(capacity, limits):
-        tree = make_tree(capacity, limits)
+    def changed(capacity, limits, stops=0):
+        tree = make_tree(capacity, limits, stops=stops)
         return tree._replace(parent=tree.parent.astype(np.int32))
 
     monkeypatch.setattr(tree_arena, "make_tree", changed)

@@ -24,7 +24,9 @@
 #            (c_k - clear) / M_k multiplied by F, (advance2) the same step in the
 #            one-two-link-arm path that checks every 2-DOF edge, (armarm) the arm-arm bound M_k + M_m divided
 #            by F, (armarm-max) replaced by max(M_k, M_m), (selfpair) the self-pair relative
-#            bound divided by F, (clearance) the user clearance held F times too leniently by
+#            bound divided by F, (advance-record, armarm-record, selfpair-record) the
+#            link-obstacle step, the arm-arm bound and the self-pair step of a stop taken from
+#            a node's stop record (3+ joints), (clearance) the user clearance held F times too leniently by
 #            edge_free, (effective) by effective_margin, (minclear-speed, minclear-curvature)
 #            the exact minimum clearance's first- and second-order lower bounds, (radius)
 #            goal-frame clearance_deg
@@ -86,6 +88,16 @@ from pathlib import Path
 variant, factor = sys.argv[1], sys.argv[2]
 collision = "xfuzzy_rrt/geometry/collision.py"
 F = factor
+# the arm-arm bound's line with the lines before it, which tell the measured stop
+# (_edge_stop writes its value to a record) from one taken from a record (_stored_stop)
+ARMARM = ("{value}\n                        col += 1\n                        if not d < np.inf:\n"
+          "                            return False, cmin, ds\n                        if d < cmin:\n"
+          "                            cmin = d\n                        mkm = {mkm}\n")
+# the self-pair step after a value read from a record (one arm's non-adjacent links)
+SELF_STEP = ("                    if not d < np.inf:\n                        return False, cmin, ds\n"
+             "                    if d < cmin:\n                        cmin = d\n"
+             "                    mkm = msf[k, m]\n                    if mkm > 0.0:\n"
+             "                        step = (d - clear) / mkm\n")
 file, old, new, tests = {
     # M_k itself (every step that uses it: link-obstacle, arm-arm, self pairs) ...
     "bound": (collision,
@@ -93,20 +105,33 @@ file, old, new, tests = {
               f"        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk / {F}\n",
               "tests/test_link_obstacle_bound.py tests/test_safety_bounds.py"),
     # ... the per-link obstacle step (c_k - clear) / M_k ...
-    "advance": (collision, "                        step = (ck - clear) / mk\n",
-                f"                        step = (ck - clear) / mk * {F}\n",
+    "advance": (collision, "\n                    step = (ck - clear) / mk\n",
+                f"\n                    step = (ck - clear) / mk * {F}\n",
                 "tests/test_link_obstacle_bound.py tests/test_margins.py"),
+    # ... the same step taken from a node's stop record (_stored_stop: an edge's first and
+    # last stop on 3+ joints in the planners) ...
+    "advance-record": (collision, "\n                step = (ck - clear) / mk\n",
+                       f"\n                step = (ck - clear) / mk * {F}\n",
+                       "tests/test_stop_records.py"),
     # ... the same step in the one-two-link-arm path (edge_free_two_link, every 2-DOF edge) ...
     "advance2": (collision, "            step = (c{k} - clear) / m{k}\n",
                  f"            step = (c{{k}} - clear) / m{{k}} * {F}\n",
                  "tests/test_link_obstacle_bound.py tests/test_margins.py"),
     # ... the arm-arm bound M_k + M_m, weakened by F or replaced by max (issue 22) ...
-    "armarm": (collision, "                            mkm = mka + mks[m]\n",
-               f"                            mkm = (mka + mks[m]) / {F}\n",
+    "armarm": (collision, ARMARM.format(value="rows[r, col] = d", mkm="mka + mks[m]"),
+               ARMARM.format(value="rows[r, col] = d", mkm=f"(mka + mks[m]) / {F}"),
                "tests/test_arm_arm_bound.py"),
-    "armarm-max": (collision, "                            mkm = mka + mks[m]\n",
-                   "                            mkm = max(mka, mks[m])\n",
+    "armarm-max": (collision, ARMARM.format(value="rows[r, col] = d", mkm="mka + mks[m]"),
+                   ARMARM.format(value="rows[r, col] = d", mkm="max(mka, mks[m])"),
                    "tests/test_arm_arm_bound.py"),
+    "armarm-record": (collision, ARMARM.format(value="d = rows[r, col]", mkm="mka + mks[m]"),
+                      ARMARM.format(value="d = rows[r, col]", mkm=f"(mka + mks[m]) / {F}"),
+                      "tests/test_stop_records.py"),
+    # ... the self-pair step taken from a stop record ...
+    "selfpair-record": (collision, "d = rows[r, col]\n                    col += 1\n" + SELF_STEP,
+                        "d = rows[r, col]\n                    col += 1\n" + SELF_STEP.replace(
+                            "/ mkm\n", f"/ mkm * {F}\n"),
+                        "tests/test_stop_records.py"),
     # ... the self-pair relative bound ...
     "selfpair": (collision, "    return link_motion_bound(links, qa_deg, qb_deg, m, k + 1)\n",
                  f"    return link_motion_bound(links, qa_deg, qb_deg, m, k + 1) / {F}\n",

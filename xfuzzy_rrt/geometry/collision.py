@@ -51,8 +51,10 @@ pair of two arms, per non-adjacent link pair of one arm) evaluated by :func:`cle
 and :func:`edge_free` (so :func:`config_free` too): a deterministic measure of planning work.
 It is only ever incremented, never read, by the kernels, so it cannot change a result. It counts
 what the algorithm measures, not how: an edge stop whose values a planner already had (the
-node check's, :func:`edge_free_two_link`) and an obstacle skipped because it cannot be the
-nearest (:func:`_link_clearance`) count as before, so counts compare across versions. A probe
+node check's: :func:`edge_free_two_link` for one two-link arm, a node's stop record
+:func:`node_stop_into` / :func:`edge_free_rows` for any other arm) and an obstacle skipped
+because it cannot be the nearest (:func:`_link_clearance`) count as before, so counts compare
+across versions. A probe
 of a blocked edge (:func:`edge_free`, *Blocked edges*) counts like a stop: the probes cut a
 blocked edge's count (5-8x on random blocked edges), which is the point of them.
 """

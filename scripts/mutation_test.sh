@@ -75,7 +75,7 @@ fi
 cd "$WORK"
 if [ -n "$WEAKEN" ]; then
   status=0
-  for variant in ${WEAKEN_VARIANTS:-bound advance advance2 armarm armarm-max selfpair clearance effective minclear-speed minclear-curvature radius}; do
+  for variant in ${WEAKEN_VARIANTS:-bound advance advance2 armarm armarm-max selfpair advance-record armarm-record selfpair-record clearance effective minclear-speed minclear-curvature radius}; do
     for f in xfuzzy_rrt/geometry/collision.py xfuzzy_rrt/geometry/clearance.py xfuzzy_rrt/planners/goal_frame.py; do
       cp "$ROOT/$f" "$f"
     done

@@ -132,6 +132,14 @@ def test_a_new_run_never_reads_the_last_runs_records():
     assert make_tree(16, np.tile([-180.0, 180.0], (5, 1))).link_clear.shape == (1, 2)
 
 
+def test_a_tree_keeps_no_records_that_would_outgrow_their_memory_cap():
+    limits = np.tile([-180.0, 180.0], (21, 1))  # three 7-joint arms: 214 columns
+    w = stop_record_width(np.array([0, 7, 14, 21]))
+    assert w == 1 + 21 + 3 * 15 + 3 * 49
+    assert make_tree(20_008, limits, stops=w).link_clear.shape == (1, 2)  # 34 MB: measured
+    assert make_tree(1_000, limits, stops=w).link_clear.shape == (1_001, w)  # 1.7 MB: kept
+
+
 @pytest.mark.parametrize("dof, arms", [(3, 1), (5, 1), (7, 1), (3, 2)])
 def test_plans_with_stop_records_are_the_plans_without_them(monkeypatch, dof, arms):
     scenario = generate_nd(4242, 0, dof=dof, arms=arms).scenario

@@ -111,6 +111,12 @@ KD_LEAF = 12
 KD_STACK = 128
 
 
+#: Largest stop-record table a tree keeps (bytes): 16 MB holds a 7-joint arm's records for a
+#: Fuzzy-RRT-Connect tree of 20,008 nodes (3.7 MB) and two 7-joint arms' (15 MB); three arms of
+#: 7 joints would need 34 MB per tree and measure both ends of each edge instead.
+RECORDS_MAX_BYTES = 16 * 2**20
+
+
 def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG,
               stops: int = 0) -> TreeArrays:
     """Empty tree for ``capacity`` nodes in the joint box ``limits_deg`` (``[dof, 2]``).
@@ -119,7 +125,9 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG,
     (:func:`~xfuzzy_rrt.geometry.collision.stop_width`,
     :attr:`~xfuzzy_rrt.geometry.scenario.ScenarioArrays.stop_width`; 0 for one two-link arm,
     which keeps its per-link values instead). With 0, or a width that is not the problem's,
-    every edge measures both its ends (the same results, more time)."""
+    every edge measures both its ends (the same results, more time), as it does when the
+    records would take more than :data:`RECORDS_MAX_BYTES` (many arms of many joints: the width
+    grows with the square of the links)."""
     limits_deg = np.asarray(limits_deg, dtype=np.float64)
     if limits_deg.ndim != 2 or limits_deg.shape[1] != 2 or limits_deg.shape[0] < 2:
         raise ValueError("the tree needs joint limits of shape [dof >= 2, 2]")
@@ -127,6 +135,8 @@ def make_tree(capacity: int, limits_deg: np.ndarray, cell_deg: float = CELL_DEG,
     ncx = max(1, int(math.ceil((limits_deg[0, 1] - limits_deg[0, 0]) / cell_deg)))
     ncy = max(1, int(math.ceil((limits_deg[1, 1] - limits_deg[1, 0]) / cell_deg)))
     kd = capacity if dof > 2 else 1
+    if int(stops) * (capacity + 1) * 8 > RECORDS_MAX_BYTES:
+        stops = 0
     # ``nodes``, ``parent`` and ``cell_next`` are written before they are read (add_node), so
     # they are left uninitialised: filling 10,000-entry arrays cost more than a short plan.
     return TreeArrays(

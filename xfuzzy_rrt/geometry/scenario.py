@@ -15,7 +15,6 @@ described in ``docs/scenarios.md``.
 from __future__ import annotations
 
 import functools
-
 import math
 import re
 import tomllib

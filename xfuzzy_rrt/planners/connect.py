@@ -142,12 +142,12 @@ def connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, st
 
     ``P`` is the problem; the goal tree sees it with start and goal swapped
     (:func:`reversed_problem`, built in the loop: its extension joins the start directly when
-    it can); ``TA``/``TB`` the empty start
-    and goal trees. With ``record`` true, row ``it - 1`` of ``TR``, ``grown`` and
-    ``connect_nodes`` describes iteration ``it``. ``counts[0]`` receives the number of
-    extensions attempted. ``stop[0] != 0`` ends the run. ``scale``: Euclidean degrees per
-    unit of the rulebook's lengths (1 for goal-frame, ``sqrt(N/2)`` for goal-frame-any): the
-    distance and clearance inputs are divided by it, the box and step outputs multiplied.
+    it can); ``TA``/``TB`` the empty start and goal trees. With ``record`` true, row
+    ``it - 1`` of ``TR``, ``grown`` and ``connect_nodes`` describes iteration ``it``.
+    ``counts[0]`` receives the number of extensions attempted. ``stop[0] != 0`` ends the
+    run. ``scale``: Euclidean degrees per unit of the rulebook's lengths (1 for goal-frame,
+    ``sqrt(N/2)`` for goal-frame-any): the distance and clearance inputs are divided by it, the
+    box and step outputs multiplied.
     """
     n_out = knots.shape[0]
     dof = P.start.shape[0]
@@ -384,7 +384,8 @@ def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots
     """:func:`connect_kernel` with the problem and trace bundles as *plain* tuples and the two
     trees as their arenas, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the
     goal tree's view of the problem is built in the kernel's loop (:func:`reversed_problem`),
-    not unboxed a second time. Returns the kernel's four values and the number of extensions attempted.
+    not unboxed a second time. Returns the kernel's four values and the number of extensions
+    attempted.
 
     ``tr`` ``None`` (a run that records nothing; ``grown`` and ``connect_nodes`` are then
     ``None`` too): the idle one-row buffers are made here

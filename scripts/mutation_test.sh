@@ -91,13 +91,11 @@ F = factor
 # the arm-arm bound's line with the lines before it, which tell the measured stop
 # (_edge_stop writes its value to a record) from one taken from a record (_stored_stop)
 ARMARM = ("{value}\n                        col += 1\n                        if not d < np.inf:\n"
-          "                            return False, cmin, ds\n                        if d < cmin:\n"
-          "                            cmin = d\n                        mkm = {mkm}\n")
+          "                            return False, cmin, ds\n"
+          "                        cmin, ds = _fold(d, {mkm}, clear, cmin, ds)\n")
 # the self-pair step after a value read from a record (one arm's non-adjacent links)
 SELF_STEP = ("                    if not d < np.inf:\n                        return False, cmin, ds\n"
-             "                    if d < cmin:\n                        cmin = d\n"
-             "                    mkm = msf[k, m]\n                    if mkm > 0.0:\n"
-             "                        step = (d - clear) / mkm\n")
+             "                    cmin, ds = _fold(d, msf[k, m], clear, cmin, ds)\n")
 file, old, new, tests = {
     # M_k itself (every step that uses it: link-obstacle, arm-arm, self pairs) ...
     "bound": (collision,
@@ -105,17 +103,19 @@ file, old, new, tests = {
               f"        mk += abs(math.radians(qb_deg[j] - qa_deg[j])) * tail\n    return mk / {F}\n",
               "tests/test_link_obstacle_bound.py tests/test_safety_bounds.py"),
     # ... the per-link obstacle step (c_k - clear) / M_k ...
-    "advance": (collision, "\n                    step = (ck - clear) / mk\n",
-                f"\n                    step = (ck - clear) / mk * {F}\n",
+    # (the step is computed by _fold, shared by every element of both kinds of stop: each
+    # variant weakens the bound one call site hands it, as if that step were F times longer)
+    "advance": (collision, "\n                cmin, ds = _fold(ck, mks[k], clear, cmin, ds)\n",
+                f"\n                cmin, ds = _fold(ck, mks[k] / {F}, clear, cmin, ds)\n",
                 "tests/test_link_obstacle_bound.py tests/test_margins.py"),
     # ... the same step taken from a node's stop record (_stored_stop: an edge's first and
     # last stop on 3+ joints in the planners) ...
-    "advance-record": (collision, "\n                step = (ck - clear) / mk\n",
-                       f"\n                step = (ck - clear) / mk * {F}\n",
+    "advance-record": (collision, "\n            cmin, ds = _fold(ck, mks[k], clear, cmin, ds)\n",
+                       f"\n            cmin, ds = _fold(ck, mks[k] / {F}, clear, cmin, ds)\n",
                        "tests/test_stop_records.py"),
     # ... the same step in the one-two-link-arm path (edge_free_two_link, every 2-DOF edge) ...
-    "advance2": (collision, "            step = (c{k} - clear) / m{k}\n",
-                 f"            step = (c{{k}} - clear) / m{{k}} * {F}\n",
+    "advance2": (collision, "_fold(c{k}, m{k}, clear, ",
+                 f"_fold(c{{k}}, m{{k}} / {F}, clear, ",
                  "tests/test_link_obstacle_bound.py tests/test_margins.py"),
     # ... the arm-arm bound M_k + M_m, weakened by F or replaced by max (issue 22) ...
     "armarm": (collision, ARMARM.format(value="rows[r, col] = d", mkm="mka + mks[m]"),
@@ -130,7 +130,7 @@ file, old, new, tests = {
     # ... the self-pair step taken from a stop record ...
     "selfpair-record": (collision, "d = rows[r, col]\n                    col += 1\n" + SELF_STEP,
                         "d = rows[r, col]\n                    col += 1\n" + SELF_STEP.replace(
-                            "/ mkm\n", f"/ mkm * {F}\n"),
+                            "msf[k, m], clear", f"msf[k, m] / {F}, clear"),
                         "tests/test_stop_records.py"),
     # ... the self-pair relative bound ...
     "selfpair": (collision, "    return link_motion_bound(links, qa_deg, qb_deg, m, k + 1)\n",

@@ -597,6 +597,22 @@ def two_link_clearances(P, q0_deg, q1_deg):
     return c0, c1
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def _fold(d, mk, clear, cmin, ds):
+    """Fold one finite clearance ``d`` (metres, with ``clear`` required) whose bodies move at
+    most ``mk`` metres per unit of ``s`` into a stop's running ``(cmin, ds)``. The one place the
+    safe advance ``(d - clear) / mk`` is computed: a stop of the one-two-link-arm path
+    (:func:`edge_free_two_link`), one measured (:func:`_edge_stop`) and one read from its record
+    (:func:`_stored_stop`) go through the very same arithmetic."""
+    if d < cmin:
+        cmin = d
+    if mk > 0.0:
+        step = (d - clear) / mk
+        if step < ds:
+            ds = step
+    return cmin, ds
+
+
 @nb.njit(cache=True, nogil=True, _nrt=False)
 def edge_free_two_link(P, qa_deg, qb_deg, margin, ca0, ca1, cb0, cb1, probe=True):
     """:func:`edge_free` for ONE arm of two links (the only single-arm case without self
@@ -646,22 +662,10 @@ def edge_free_two_link(P, qa_deg, qb_deg, margin, ca0, ca1, cb0, cb1, probe=True
         # edge_free's per-link checks, link 0 then link 1
         if not c0 < np.inf:
             return False, ca0, ca1
-        cmin = np.inf
-        ds = np.inf
-        if c0 < cmin:
-            cmin = c0
-        if m0 > 0.0:
-            step = (c0 - clear) / m0
-            if step < ds:
-                ds = step
+        cmin, ds = _fold(c0, m0, clear, np.inf, np.inf)
         if not c1 < np.inf:
             return False, ca0, ca1
-        if c1 < cmin:
-            cmin = c1
-        if m1 > 0.0:
-            step = (c1 - clear) / m1
-            if step < ds:
-                ds = step
+        cmin, ds = _fold(c1, m1, clear, cmin, ds)
         if cmin <= margin:
             return False, ca0, ca1
         if s >= 1.0:
@@ -714,13 +718,7 @@ def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has
                     rows[r, 1 + k] = ck
                 if not ck < np.inf:
                     return False, cmin, ds
-                if ck < cmin:
-                    cmin = ck
-                mk = mks[k]
-                if mk > 0.0:
-                    step = (ck - clear) / mk
-                    if step < ds:
-                        ds = step
+                cmin, ds = _fold(ck, mks[k], clear, cmin, ds)
             x = nx
             y = ny
     if n_arms > 1:
@@ -738,13 +736,7 @@ def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has
                         col += 1
                         if not d < np.inf:
                             return False, cmin, ds
-                        if d < cmin:
-                            cmin = d
-                        mkm = mka + mks[m]
-                        if mkm > 0.0:
-                            step = (d - clear) / mkm
-                            if step < ds:
-                                ds = step
+                        cmin, ds = _fold(d, mka + mks[m], clear, cmin, ds)
     if has_self:
         for a in range(n_arms):
             rr = P.radii[a] + P.radii[a]
@@ -757,13 +749,7 @@ def _edge_stop(P, qa_deg, qb_deg, s, mks, msf, seg, clear, n_arms, need_seg, has
                     col += 1
                     if not d < np.inf:
                         return False, cmin, ds
-                    if d < cmin:
-                        cmin = d
-                    mkm = msf[k, m]
-                    if mkm > 0.0:
-                        step = (d - clear) / mkm
-                        if step < ds:
-                            ds = step
+                    cmin, ds = _fold(d, msf[k, m], clear, cmin, ds)
     return True, cmin, ds
 
 
@@ -780,13 +766,7 @@ def _stored_stop(P, rows, r, mks, msf, clear, n_arms, has_obstacles, has_self):
             ck = rows[r, 1 + k]
             if not ck < np.inf:
                 return False, cmin, ds
-            if ck < cmin:
-                cmin = ck
-            mk = mks[k]
-            if mk > 0.0:
-                step = (ck - clear) / mk
-                if step < ds:
-                    ds = step
+            cmin, ds = _fold(ck, mks[k], clear, cmin, ds)
     col = 1 + P.links.shape[0]
     if n_arms > 1:
         for a in range(n_arms):
@@ -798,13 +778,7 @@ def _stored_stop(P, rows, r, mks, msf, clear, n_arms, has_obstacles, has_self):
                         col += 1
                         if not d < np.inf:
                             return False, cmin, ds
-                        if d < cmin:
-                            cmin = d
-                        mkm = mka + mks[m]
-                        if mkm > 0.0:
-                            step = (d - clear) / mkm
-                            if step < ds:
-                                ds = step
+                        cmin, ds = _fold(d, mka + mks[m], clear, cmin, ds)
     if has_self:
         for a in range(n_arms):
             for k in range(P.arm_first[a], P.arm_first[a + 1]):
@@ -813,13 +787,7 @@ def _stored_stop(P, rows, r, mks, msf, clear, n_arms, has_obstacles, has_self):
                     col += 1
                     if not d < np.inf:
                         return False, cmin, ds
-                    if d < cmin:
-                        cmin = d
-                    mkm = msf[k, m]
-                    if mkm > 0.0:
-                        step = (d - clear) / mkm
-                        if step < ds:
-                            ds = step
+                    cmin, ds = _fold(d, msf[k, m], clear, cmin, ds)
     return True, cmin, ds
 
 

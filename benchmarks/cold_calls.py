@@ -8,13 +8,16 @@ level with the tuned RRT's warm and 0.82x cold (README, "Against tuned peers", t
 sessions). This script measures that setting on its own, in one process, so that a change to
 the call path can be judged where the aims are measured.
 
-Per problem and seed the default (``fuzzy-rrt`` with its rulebooks loaded once) and
-``rrt:tuned`` (its settings read once) are called in an order shuffled per seed
-(``bench.protocol.call_order``); before each timed call ``--evict-mb`` megabytes are written (32:
-the whole L3 of the machine this was written on; 0: warm). Printed per folder: both planners'
-median call and kernel time (``PlanResult.wall_s``) over problems, and the tuned call over the
-default's, median and geometric mean of per-problem ratios (a failed run counts as infinitely
-slow). Run on problems nobody tuned on, on a quiet machine::
+Per problem and seed the default (``fuzzy-rrt`` with its rulebooks loaded once) and ``rrt:tuned``
+(its settings read once) are called in an order shuffled per seed (``bench.protocol.call_order``);
+before each timed call ``--evict-mb`` megabytes are written (by default what ``evaluate --caches
+cold`` writes: 1.5x the last-level cache the OS reports, at most 512 MB, ``bench/caches.py``; 0:
+warm). A fixed size is not cold everywhere: where the L3 is 480 MB, 48 MB written leave most of a
+call's code and data in it, and the calls measured 2.5x faster than in ``evaluate`` (README,
+"Against tuned peers", fifteenth session). Printed per folder: both planners' median call and
+kernel time (``PlanResult.wall_s``) over problems, and the tuned call over the default's, median
+and geometric mean of per-problem ratios (a failed run counts as infinitely slow). Run on
+problems nobody tuned on, on a quiet machine::
 
     nice python benchmarks/cold_calls.py /tmp/eval-sample /tmp/eval-dof3 --seeds 30
     nice python benchmarks/cold_calls.py /tmp/eval-dof3 --evict-mb 0      # warm
@@ -66,10 +69,15 @@ def main(argv=None) -> int:
     ap.add_argument("folders", nargs="+", type=Path, help="folders of scenario .toml files")
     ap.add_argument("--count", type=int, default=32, help="problems per folder (first N)")
     ap.add_argument("--seeds", type=int, default=30)
-    ap.add_argument("--evict-mb", type=float, default=32.0,
-                    help="megabytes written before every timed call (0: warm caches)")
+    ap.add_argument("--evict-mb", type=float, default=None,
+                    help="megabytes written before every timed call (default: as evaluate "
+                         "--caches cold, 1.5x the last-level cache; 0: warm caches)")
     args = ap.parse_args(argv)
+    from xfuzzy_rrt.bench.caches import evict_bytes, last_level_cache_bytes
     from xfuzzy_rrt.geometry.scenario import load_scenario
+
+    if args.evict_mb is None:
+        args.evict_mb = evict_bytes(last_level_cache_bytes()) / 2**20
 
     for folder in args.folders:
         files = sorted(folder.glob("*.toml"))[:args.count]

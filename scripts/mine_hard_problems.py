@@ -13,12 +13,14 @@ training round sees them. It is part of how the shipped ``goal-frame-any`` was m
 
 For every ``*.toml`` in each DIR (sorted by name) the default (``fuzzy-rrt`` with its shipped
 rulebooks as loaded now; with ``--rulebook``, ``fuzzy-rrt-connect`` with that ``goal-frame-any``
-rulebook -- the same planner on problems that are not one 2-joint arm, so a later session can
-mine with the rulebook a training round started from) and ``rrt:tuned`` plan seeds ``0 .. --seeds - 1`` with the training
-budget ``--max-iter``; a failed run of the default counts three times its work. A problem whose
-tuned RRT's median work over the default's is below ``--below`` (1.0) is copied to
-``OUT/<DIR's name>/``. Prints every problem's ratio and the count; deterministic (work counts,
-not times).
+rulebook -- the same planner on problems that are not one 2-joint arm, so a later session can mine
+with the rulebook a training round started from) and ``rrt:tuned`` plan seeds ``0 .. --seeds - 1``
+with the training budget ``--max-iter``; a failed run of the default counts three times its work. A
+problem whose tuned RRT's median work over the default's is below ``--below`` (1.0) is copied to
+``OUT/<DIR's name>/``. Prints every problem's ratio and the count; deterministic (work counts, not
+times). The work is the search's (``PlanResult.work``), not end to end (``evaluate``'s
+``work_total`` adds the path's certification): it is what the training's work-cvar fitness compares
+(``training/evaluate.py``), and the problems are mined for that fitness.
 """
 
 from __future__ import annotations
@@ -40,7 +42,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--rulebook", type=Path, default=None)
     args = parser.parse_args(argv)
 
+    from xfuzzy_rrt.errors import InputError
     from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.training.run import expand_scenarios
     from xfuzzy_rrt.planners.api import load_shipped_default, load_tuned_rrt, plan_scenario
 
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
@@ -52,9 +56,13 @@ def main(argv: list[str] | None = None) -> int:
     tuned = load_tuned_rrt()
     kept = total = 0
     for folder in args.dirs:
-        files = sorted(folder.glob("*.toml"))
-        if not files:
-            print(f"{folder}: no scenario files", file=sys.stderr)
+        if not folder.is_dir():
+            print(f"{folder}: not a folder", file=sys.stderr)
+            return 2
+        try:  # the training command's reading of a folder (one line for a bad one)
+            files = expand_scenarios([folder])
+        except InputError as err:
+            print(err, file=sys.stderr)
             return 2
         for path in files:
             scenario = load_scenario(path)

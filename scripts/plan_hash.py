@@ -45,14 +45,20 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     from xfuzzy_rrt.planners.api import plan_scenario
+    from xfuzzy_rrt.errors import InputError
     from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.training.run import expand_scenarios
 
     total = hashlib.sha256()
     runs = 0
     for folder in args.dirs:
-        files = sorted(folder.glob("*.toml"))[: args.problems]
-        if not files:
-            print(f"{folder}: no scenario files", file=sys.stderr)
+        if not folder.is_dir():
+            print(f"{folder}: not a folder", file=sys.stderr)
+            return 2
+        try:  # the training command's reading of a folder (one line for a bad one)
+            files = expand_scenarios([folder])[: args.problems]
+        except InputError as err:
+            print(err, file=sys.stderr)
             return 2
         for path in files:
             scenario = load_scenario(path)

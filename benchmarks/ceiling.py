@@ -14,7 +14,7 @@ be met on that problem by a better search, only by a cheaper call (which ``rrt:t
 
 Per problem and seed the three calls (the default, its one-iteration floor, ``rrt:tuned``) run
 back to back, their order rotated from seed to seed (a fixed order favours the later calls:
-README, "Against tuned peers", "Measuring: the order of calls"). Printed per folder:
+docs/peer-measurements.md, "Measuring: the order of calls"). Printed per folder:
 ``rrt:tuned``'s median call, the floor, the median and worst ceiling, how many problems have a
 ceiling below 2x, and the measured default speed-up (median of per-problem ratios) beside it.
 Run on problems nobody tuned on::

@@ -4,7 +4,7 @@ Why: ``xfuzzy-rrt evaluate`` times each planner between calls of four others (th
 grows 10,000-node trees at 3+ joints, OMPL's calls are mostly Python), so a call often starts
 with its code and data evicted from the caches -- as a user's does who runs anything between two
 plans. A call that is fast warm can be slow cold: on 3-joint problems the default's calls were
-level with the tuned RRT's warm and 0.82x cold (README, "Against tuned peers", tenth and eleventh
+level with the tuned RRT's warm and 0.82x cold (docs/peer-measurements.md, tenth and eleventh
 sessions). This script measures that setting on its own, in one process, so that a change to
 the call path can be judged where the aims are measured.
 
@@ -13,8 +13,8 @@ Per problem and seed the default (``fuzzy-rrt`` with its rulebooks loaded once) 
 before each timed call ``--evict-mb`` megabytes are written (by default what ``evaluate --caches
 cold`` writes: 1.5x the last-level cache the OS reports, at most 512 MB, ``bench/caches.py``; 0:
 warm). A fixed size is not cold everywhere: where the L3 is 480 MB, 48 MB written leave most of a
-call's code and data in it, and the calls measured 2.5x faster than in ``evaluate`` (README,
-"Against tuned peers", fifteenth session). Printed per folder: both planners' median call and
+call's code and data in it, and the calls measured 2.5x faster than in ``evaluate``
+(docs/peer-measurements.md, fifteenth session). Printed per folder: both planners' median call and
 kernel time (``PlanResult.wall_s``) over problems, and the tuned call over the default's, median
 and geometric mean of per-problem ratios (a failed run counts as infinitely slow). Run on
 problems nobody tuned on, on a quiet machine::

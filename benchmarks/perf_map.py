@@ -5,7 +5,7 @@ Why: ``perf`` sees numba's machine code as anonymous addresses, so a profile of 
 file; this script keeps those objects as they are loaded, reads their ELF symbol tables (name,
 size) and asks numba's engine where each symbol landed, then writes ``/tmp/perf-PID.map``, the
 file ``perf report`` reads to name JIT code. With it the thirteenth session found where a
-5-joint default call spent its time (README, "Against tuned peers"): the certified edge check,
+5-joint default call spent its time (docs/peer-measurements.md): the certified edge check,
 the distances and sin/cos took what they take in the tuned RRT; the Connect loop itself was
 the difference.
 

@@ -1,7 +1,7 @@
 """The state of the CPU caches a timed call starts from: what the fair protocol controls.
 
 Why this matters: a short plan takes 20-200 us when repeated, and a call whose code and data
-are out of the caches takes several times as long (README, "Against tuned peers", twelfth
+are out of the caches takes several times as long (docs/peer-measurements.md, twelfth
 session: 164 against 26 us at 2 joints). A protocol that calls several planners in turn leaves
 each call with whatever the previous calls left, so a planner that shares its compiled kernel
 with another one in the run (``rrt:tuned`` and the paper's ``rrt`` are one kernel) starts warm

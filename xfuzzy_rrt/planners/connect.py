@@ -391,7 +391,7 @@ def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots
     ``None`` too): the idle one-row buffers are made here
     (:func:`~xfuzzy_rrt.planners.trace_record.idle_buffers`), like the extension counter, so
     an untraced call unboxes 16 arrays fewer (half its arguments; ~12 us of a 3-joint call
-    with cold caches; README, "Against tuned peers", eleventh session)."""
+    with cold caches; docs/peer-measurements.md, eleventh session)."""
     P = Problem(*p)
     if tr is None:
         TR = idle_buffers(P.start.shape[0], knots.shape[0], 1)

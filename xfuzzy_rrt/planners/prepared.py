@@ -59,7 +59,7 @@ def pooled_trees(capacity: int, limits_deg: np.ndarray, count: int,
     The look-up is by the limits array's identity first: every plan of a scenario passes the
     same array (:func:`scenario_arrays`), and hashing its bytes, ``asarray`` and the LRU's
     bookkeeping cost ~19 us of a call that starts with cold caches (27.5 against 8.6 us;
-    README, "Against tuned peers", twelfth session), for every planner. The entry keeps the
+    docs/peer-measurements.md, twelfth session), for every planner. The entry keeps the
     array, so its identity cannot be taken by another array while it is remembered; like the
     set-ups that hold the same arrays (:mod:`.setup_memo`), it relies on nobody writing into a
     scenario's arrays."""

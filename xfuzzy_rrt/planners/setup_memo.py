@@ -137,8 +137,8 @@ def last_call(site: str, scenario: Any, settings: tuple) -> Any | None:
     *objects* (``is``, one by one), else None.
 
     Why: building the exact key (an :func:`exact` call per setting) and looking it up cost
-    ~29 us of a call that starts with cold caches and ~1 us warm, for every planner (README,
-    "Against tuned peers", twelfth session); a loop of plans passes the same objects every
+    ~29 us of a call that starts with cold caches and ~1 us warm, for every planner
+    (docs/peer-measurements.md, twelfth session); a loop of plans passes the same objects every
     time. Identical objects are equal in value and type, so a hit is exactly a hit of the key;
     a loaded rulebook among the settings must be the same object too. Anything else (another
     object of equal value, a rulebook given as a directory or ``None``, which must be resolved

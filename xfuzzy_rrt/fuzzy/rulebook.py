@@ -31,6 +31,7 @@ import os
 import re
 import tempfile
 import time
+import weakref
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -328,6 +329,17 @@ def _rulebooks_env() -> str | None:
     return _ENV_DECODE(raw) if raw else None
 
 
+def rulebooks_env_token():
+    """The value of :data:`RULEBOOKS_ENV` as ``os.environ`` stores it (bytes on POSIX), or
+    None: a key for caches that follow the variable, read without decoding. Why: with cold
+    caches ``os.environ.get`` of an unset variable (its Python frames and the KeyError it
+    catches) took ~40 us, more than half of a rulebook label's parse
+    (docs/peer-measurements.md, sixteenth session)."""
+    if _ENV_DATA is None:
+        return os.environ.get(RULEBOOKS_ENV)
+    return _ENV_DATA.get(_ENV_KEY)
+
+
 def shipped_rulebook_str(name: str = DEFAULT_RULEBOOK) -> str:
     """``rulebooks_dir() / name`` as an absolute string, what every plan call without a
     rulebook looks up: the environment is read on every call (it may change), the path built
@@ -567,10 +579,30 @@ def load_rulebook(path: str | os.PathLike[str]) -> Rulebook:
         systems.append(fis)
     if problems:
         raise RulebookError(problems)
-    return Rulebook(
+    rulebook = Rulebook(
         name=manifest.name, bounds_mode=manifest.bounds_mode, systems=tuple(systems),
         provenance=manifest.provenance, description=manifest.description, semantics=sem,
     )
+    _LOADED_FROM[id(rulebook)] = os.path.abspath(root)
+    weakref.finalize(rulebook, _LOADED_FROM.pop, id(rulebook), None)
+    return rulebook
+
+
+#: ``id(rulebook) -> the absolute directory`` :func:`load_rulebook` read it from; an entry
+#: leaves with its rulebook (``weakref.finalize``), so an id is never reused while listed.
+_LOADED_FROM: dict[int, str] = {}
+
+
+def loaded_from(rulebook: Any) -> str | None:
+    """The absolute directory :func:`load_rulebook` read *rulebook* from (as it was named,
+    symlinks kept), or None for one built in memory.
+
+    Why: a caller that loads a rulebook once and plans with a label naming the same folder
+    (``evaluate``, ``bench``: ``fuzzy-rrt:goal-frame`` with the loaded object) is known to pass
+    that folder's rulebook without touching the file system; with cold caches the folder's
+    freshness check (a poll and a stat) cost ~100 us of a ~300 us 2-joint call
+    (docs/peer-measurements.md, sixteenth session)."""
+    return _LOADED_FROM.get(id(rulebook))
 
 
 _BOUND_FILE = re.compile(r"bound_([1-9][0-9]*)\Z")

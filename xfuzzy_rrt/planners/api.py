@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.fuzzy.rulebook import RULEBOOKS_ENV
+from xfuzzy_rrt.fuzzy.rulebook import rulebooks_env_token
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners import registry as _registry
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
@@ -223,7 +223,7 @@ def parse_planner(name: str, where: str = "--planners", recheck: bool = True) ->
         if recheck or not entry.plan_rechecks:
             entry.parse_fn(name, arg, where)  # the hook checks again: its verdict may change
         return spec
-    key = (name, os.environ.get(RULEBOOKS_ENV))  # a shipped name's folder follows the variable
+    key = (name, rulebooks_env_token())  # a shipped name's folder follows the variable
     spec = _PARSED_SPECS.get(key)
     if spec is not None and spec.planner is entry:
         return spec
@@ -346,7 +346,8 @@ def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed
     if default is not None:  # the shipped default, preloaded: the same as rulebook=None
         rulebook = None
     if spec.rulebook_dir is not None:
-        if rulebook is not None and not _same_rulebook(rulebook, spec.rulebook_dir):
+        if (rulebook is not None and not (rulebook is _PROVEN[0] and spec.rulebook_dir is _PROVEN[1])
+                and not _same_rulebook(rulebook, spec.rulebook_dir)):
             raise InputError("--rulebook", f"conflicts with --planner {spec.label} (which "
                              "names its own rulebook); give only one")
         rulebook = rulebook if rulebook is not None else spec.rulebook_dir
@@ -393,11 +394,25 @@ def _tuned_rrt(where: str) -> dict[str, float]:
     return tuned
 
 
-def _same_rulebook(rulebook, directory: Path) -> bool:
-    """A loaded rulebook or a path that is the rulebook in ``directory``."""
-    if hasattr(rulebook, "sha256"):
-        from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached
+#: The last ``(rulebook, folder)`` :func:`_same_rulebook` found read from that folder: a loop of
+#: plans passes the same two objects every time (the folder is the cached label spec's), and
+#: the verdict cannot change while they live, so the call skips even the comparison.
+_PROVEN: list = [None, None]
 
+
+def _same_rulebook(rulebook, directory: Path) -> bool:
+    """A loaded rulebook or a path that is the rulebook in ``directory``.
+
+    A rulebook :func:`~xfuzzy_rrt.fuzzy.rulebook.load_rulebook` read from ``directory`` (the
+    same absolute path) is that folder's rulebook as the caller loaded it, even if the folder
+    changed since: no file is touched (``loaded_from``). Any other is compared by content with
+    the folder's current rulebook."""
+    if hasattr(rulebook, "sha256"):
+        from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached, loaded_from
+
+        if loaded_from(rulebook) == os.path.abspath(directory):
+            _PROVEN[:] = (rulebook, directory)
+            return True
         return rulebook.sha256 == load_rulebook_cached(directory).sha256
     return Path(rulebook).resolve() == Path(directory).resolve()
 

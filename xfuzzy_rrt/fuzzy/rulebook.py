@@ -598,9 +598,9 @@ def loaded_from(rulebook: Any) -> str | None:
     symlinks kept), or None for one built in memory.
 
     Why: a caller that loads a rulebook once and plans with a label naming the same folder
-    (``evaluate``, ``bench``: ``fuzzy-rrt:goal-frame`` with the loaded object) is known to pass
-    that folder's rulebook without touching the file system; with cold caches the folder's
-    freshness check (a poll and a stat) cost ~100 us of a ~300 us 2-joint call
+    (``bench``, library loops: ``fuzzy-rrt:goal-frame`` with the loaded object) is known to
+    pass that folder's rulebook without touching the file system; with cold caches the
+    folder's freshness check (a poll and a stat) cost ~120 us of a ~480 us 2-joint call
     (docs/peer-measurements.md, sixteenth session)."""
     return _LOADED_FROM.get(id(rulebook))
 

@@ -1,5 +1,5 @@
 """A caller that loads a rulebook once and plans with a label naming a folder
-(``plan_scenario(s, "fuzzy-rrt:DIR", rulebook=rb)``, as ``evaluate`` and ``bench`` do): a
+(``plan_scenario(s, "fuzzy-rrt:DIR", rulebook=rb)``, as ``bench`` does): a
 rulebook read from that very folder is accepted without touching the file system, any other
 must have the folder's content, and the record of where a rulebook was read from leaves with
 the rulebook."""

@@ -319,32 +319,24 @@ except AttributeError:  # another implementation: the public way
     _ENV_DATA = None
 
 
-def _rulebooks_env() -> str | None:
+def rulebooks_env() -> str | None:
     """``os.environ.get(RULEBOOKS_ENV) or None``, read on every call (the environment may
     change) but ~10x cheaper: ``os.environ.get`` encodes its key each time (~2 us in a VM, a
-    fiftieth of a plan call's budget). Assignments to ``os.environ`` update the same store."""
+    fiftieth of a plan call's budget) and, with cold caches, its Python frames and the KeyError
+    it catches for an unset variable took ~40 us, more than half of a rulebook label's parse
+    (docs/peer-measurements.md, sixteenth session). Assignments to ``os.environ`` update the
+    same store."""
     if _ENV_DATA is None:
         return os.environ.get(RULEBOOKS_ENV) or None
     raw = _ENV_DATA.get(_ENV_KEY)
     return _ENV_DECODE(raw) if raw else None
 
 
-def rulebooks_env_token():
-    """The value of :data:`RULEBOOKS_ENV` as ``os.environ`` stores it (bytes on POSIX), or
-    None: a key for caches that follow the variable, read without decoding. Why: with cold
-    caches ``os.environ.get`` of an unset variable (its Python frames and the KeyError it
-    catches) took ~40 us, more than half of a rulebook label's parse
-    (docs/peer-measurements.md, sixteenth session)."""
-    if _ENV_DATA is None:
-        return os.environ.get(RULEBOOKS_ENV)
-    return _ENV_DATA.get(_ENV_KEY)
-
-
 def shipped_rulebook_str(name: str = DEFAULT_RULEBOOK) -> str:
     """``rulebooks_dir() / name`` as an absolute string, what every plan call without a
     rulebook looks up: the environment is read on every call (it may change), the path built
     once per value of it (a ``Path`` join and ``abspath`` cost more than the look-up's stats)."""
-    return _shipped_dir_str(_rulebooks_env(), name)
+    return _shipped_dir_str(rulebooks_env(), name)
 
 
 def default_rulebook_str() -> str:

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.fuzzy.rulebook import rulebooks_env_token
+from xfuzzy_rrt.fuzzy.rulebook import rulebooks_env
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners import registry as _registry
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
@@ -223,7 +223,7 @@ def parse_planner(name: str, where: str = "--planners", recheck: bool = True) ->
         if recheck or not entry.plan_rechecks:
             entry.parse_fn(name, arg, where)  # the hook checks again: its verdict may change
         return spec
-    key = (name, rulebooks_env_token())  # a shipped name's folder follows the variable
+    key = (name, rulebooks_env())  # a shipped name's folder follows the variable
     spec = _PARSED_SPECS.get(key)
     if spec is not None and spec.planner is entry:
         return spec
@@ -346,8 +346,7 @@ def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed
     if default is not None:  # the shipped default, preloaded: the same as rulebook=None
         rulebook = None
     if spec.rulebook_dir is not None:
-        if (rulebook is not None and not (rulebook is _PROVEN[0] and spec.rulebook_dir is _PROVEN[1])
-                and not _same_rulebook(rulebook, spec.rulebook_dir)):
+        if rulebook is not None and not _same_rulebook(rulebook, spec.rulebook_dir):
             raise InputError("--rulebook", f"conflicts with --planner {spec.label} (which "
                              "names its own rulebook); give only one")
         rulebook = rulebook if rulebook is not None else spec.rulebook_dir
@@ -396,7 +395,7 @@ def _tuned_rrt(where: str) -> dict[str, float]:
 
 #: The last ``(rulebook, folder)`` :func:`_same_rulebook` found read from that folder: a loop of
 #: plans passes the same two objects every time (the folder is the cached label spec's), and
-#: the verdict cannot change while they live, so the call skips even the comparison.
+#: the verdict cannot change while they live, so the next call skips the path comparison.
 _PROVEN: list = [None, None]
 
 
@@ -407,6 +406,8 @@ def _same_rulebook(rulebook, directory: Path) -> bool:
     same absolute path) is that folder's rulebook as the caller loaded it, even if the folder
     changed since: no file is touched (``loaded_from``). Any other is compared by content with
     the folder's current rulebook."""
+    if rulebook is _PROVEN[0] and directory is _PROVEN[1]:
+        return True
     if hasattr(rulebook, "sha256"):
         from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached, loaded_from
 

@@ -63,7 +63,6 @@ def main(argv=None) -> int:
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
     from xfuzzy_rrt.geometry.scenario import load_scenario
     from xfuzzy_rrt.planners.fuzzy_rrt import BOUNDS_ABSOLUTE, MIN_STEP_DEG
-    from xfuzzy_rrt.planners.trace_record import make_trace
     from xfuzzy_rrt.planners.tree import make_tree
     from xfuzzy_rrt.resources import paper_reference_scenario
     from xfuzzy_rrt.training.evaluate import TrainingProblem, run_population
@@ -85,7 +84,7 @@ def main(argv=None) -> int:
         knots, consts = decode(genes)
         return run_population(pr.bundle, make_tree(10_002, pr.limits), knots, consts,
                               BOUNDS_ABSOLUTE, seeds, 10_000, MIN_STEP_DEG,
-                              np.zeros(1, dtype=np.int64), make_trace(1, pr.dof, 6, 1))
+                              np.zeros(1, dtype=np.int64))
 
     load0 = os.getloadavg()
     planner_kernel_loop(pop[:2])  # compile / load both loops here

@@ -2,9 +2,10 @@
 output, the fired rules and the box) plans exactly what the untraced run plans -- same path,
 tree, iterations and work -- for goal-frame Fuzzy-RRT at 2 joints and Fuzzy-RRT-Connect, with
 the DOF-free rulebook whose lengths are scaled at 3 and 5 joints and with two arms, and the
-paper's semantics (one fuzzy evaluation per arm). An untraced run's entry makes its own idle
-buffers (``idle_buffers``): they must be ``make_trace``'s one-row buffers, so that both runs
-use one compiled kernel."""
+paper's semantics (one fuzzy evaluation per arm). An untraced run passes no trace arrays
+(``None``) and runs a kernel specialisation compiled without trace code (the one the trainer
+runs: its runs equal the planner's, tests/test_work_fitness.py and
+test_goal_frame_any_training.py); it must decide exactly as the traced one."""
 
 from __future__ import annotations
 
@@ -15,7 +16,6 @@ from conftest import FIXTURES
 from test_ndof_paths_oracle import dual_arm, single_arm
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.api import plan_scenario
-from xfuzzy_rrt.planners.trace_record import idle_buffers, make_trace
 
 CASES = [
     (lambda: load_scenario(FIXTURES / "scenarios" / "two-circles.toml"), "fuzzy-rrt:goal-frame"),
@@ -41,16 +41,3 @@ def test_an_untraced_run_plans_exactly_what_a_traced_run_plans(make, label):
         assert np.array_equal(plain.path_deg, traced.path_deg)
         assert np.array_equal(plain.tree_nodes_deg, traced.tree_nodes_deg)
         assert np.array_equal(plain.tree_parent, traced.tree_parent)
-
-
-@pytest.mark.parametrize("dof, n_out, groups", [(2, 6, 1), (3, 6, 1), (7, 6, 1), (6, 8, 2)])
-def test_idle_buffers_made_in_compiled_code_are_make_traces_one_row_buffers(dof, n_out, groups):
-    made = idle_buffers(dof, n_out, groups)
-    expected = make_trace(1, dof, n_out, groups)
-    assert made._fields == expected._fields
-    for name, got, want in zip(expected._fields, made, expected):
-        assert (got.dtype, got.shape) == (want.dtype, want.shape), name
-        # what numba types an array by (dtype, dimensions, layout, mutability, alignment):
-        # equal, so an untraced run calls the very kernel specialisation a traced run calls
-        assert got.flags.c_contiguous and got.flags.writeable and got.flags.aligned, name
-

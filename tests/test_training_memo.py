@@ -16,7 +16,6 @@ from conftest import FIXTURES
 from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
 from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.fuzzy_rrt import BOUNDS_ABSOLUTE, BOUNDS_RELATIVE, MIN_STEP_DEG
-from xfuzzy_rrt.planners.trace_record import make_trace
 from xfuzzy_rrt.planners.tree import make_tree
 from xfuzzy_rrt.resources import paper_reference_scenario
 from xfuzzy_rrt.training.evaluate import TrainingProblem, run_population
@@ -42,8 +41,7 @@ def _both(problem: TrainingProblem, genes: np.ndarray, bounds: str, dof: int, se
     knots, consts = decode(genes, bounds, dof)
     reference = run_population(problem.bundle, make_tree(MAX_ITER + 2, problem.limits), knots,
                                consts, mode, seeds, MAX_ITER, MIN_STEP_DEG,
-                               np.zeros(1, dtype=np.int64),
-                               make_trace(1, problem.dof, knots.shape[1], problem.groups))
+                               np.zeros(1, dtype=np.int64))
     remembered = paper_population(problem.bundle, make_tree(MAX_ITER + 2, problem.limits),
                                   knots, consts, mode, seeds, MAX_ITER, MIN_STEP_DEG)
     return reference, remembered

@@ -97,11 +97,10 @@ from xfuzzy_rrt.planners.result import (
 )
 from xfuzzy_rrt.planners.rng import seed_state
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
-from xfuzzy_rrt.planners.trace_record import make_trace, record_iteration
+from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.planners.prepared import pooled_trees, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import set_up
-from xfuzzy_rrt.planners.trace_record import TraceArrays, idle_buffers
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
@@ -135,15 +134,17 @@ def reversed_problem(P):
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
-                   TR, grown, connect_nodes, counts):
+def connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, TR, grown,
+                   connect_nodes, counts):
     """Run Fuzzy-RRT-Connect; return ``(success, iterations, junction node in TA, junction
     node in TB)`` (-1, -1 on failure). The two junction nodes hold the same configuration.
 
     ``P`` is the problem; the goal tree sees it with start and goal swapped
     (:func:`reversed_problem`, built in the loop: its extension joins the start directly when
-    it can); ``TA``/``TB`` the empty start and goal trees. With ``record`` true, row
-    ``it - 1`` of ``TR``, ``grown`` and ``connect_nodes`` describes iteration ``it``.
+    it can); ``TA``/``TB`` the empty start and goal trees. With trace arrays ``TR``
+    (:func:`~xfuzzy_rrt.planners.trace_record.make_trace`), row ``it - 1`` of ``TR``, ``grown``
+    and ``connect_nodes`` describes iteration ``it``; ``TR`` ``None`` (and ``grown``,
+    ``connect_nodes`` ``None``) records nothing, through a loop compiled without trace code.
     ``counts[0]`` receives the number of extensions attempted. ``stop[0] != 0`` ends the
     run. ``scale``: Euclidean degrees per unit of the rulebook's lengths (1 for goal-frame,
     ``sqrt(N/2)`` for goal-frame-any): the distance and clearance inputs are divided by it, the
@@ -153,7 +154,7 @@ def connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, st
     dof = P.start.shape[0]
     # an uncounted loop (README, "No reference counting in the loops") borrows these buffers
     return _connect_loop(
-        P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record, TR, grown,
+        P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, TR, grown,
         connect_nodes, counts, np.empty(4, dtype=np.uint64), np.empty(4, dtype=np.float64),
         np.empty(n_out, dtype=np.float64), np.empty(n_out, dtype=np.float64),
         np.empty((n_out, MAX_FIRED), dtype=np.int32),
@@ -163,9 +164,9 @@ def connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, st
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
-def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, record,
-                  TR, grown, connect_nodes, counts, state, x, y, ys, dummy_rule, dummy_w, box,
-                  vecs, current, reject):
+def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, TR, grown,
+                  connect_nodes, counts, state, x, y, ys, dummy_rule, dummy_w, box, vecs,
+                  current, reject):
     """:func:`connect_kernel`'s loop, given its scratch buffers (``vecs``: one row each for
     the sample, ``e``, the near and new configurations of both trees and the target)."""
     seed_state(seed, state)
@@ -232,10 +233,10 @@ def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, sto
         x[1] = stagnation
         x[2] = c_in
         x[3] = reject[g]
-        if record:
-            infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
-        else:
+        if TR is None:  # decided when compiled (trace_record.py)
             infer(knots, consts, x, y, dummy_rule, dummy_w, False)
+        else:
+            infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
         ys[0] = y[0]
         ys[1] = y[1]
         for k in range(2, n_out):  # lengths back to joint-space degrees
@@ -282,7 +283,7 @@ def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, sto
         if gap < best:
             best = gap
             stagnation = 0.0
-        if record:
+        if TR is not None:
             row_outcome = GOAL_REACHED if meet_g >= 0 else outcome
             record_iteration(TR, row, from_node, x, y, box, target_sampled, sample, near,
                              q_new, row_outcome, k, TA.meta[0] + TB.meta[0])
@@ -380,7 +381,7 @@ def finish_connect_run(nodes_a, parent_a, na, nodes_b, parent_b, nb_, last_a, la
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots, consts, scale,
-                  min_step, stop, record, tr, grown, connect_nodes):
+                  min_step, stop, tr, grown, connect_nodes):
     """:func:`connect_kernel` with the problem and trace bundles as *plain* tuples and the two
     trees as their arenas, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the
     goal tree's view of the problem is built in the kernel's loop (:func:`reversed_problem`),
@@ -388,24 +389,20 @@ def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots
     attempted.
 
     ``tr`` ``None`` (a run that records nothing; ``grown`` and ``connect_nodes`` are then
-    ``None`` too): the idle one-row buffers are made here
-    (:func:`~xfuzzy_rrt.planners.trace_record.idle_buffers`), like the extension counter, so
-    an untraced call unboxes 16 arrays fewer (half its arguments; ~12 us of a 3-joint call
-    with cold caches; docs/peer-measurements.md, eleventh session)."""
+    ``None`` too): the kernel compiled without trace code runs, and no trace array is unboxed
+    (an untraced call passed 16 idle arrays until the eleventh session, ~12 us of a 3-joint
+    call with cold caches; docs/peer-measurements.md)."""
     P = Problem(*p)
-    if tr is None:
-        TR = idle_buffers(P.start.shape[0], knots.shape[0], 1)
-        tree_of_row = np.zeros(1, dtype=np.int8)
-        connected = np.zeros(1, dtype=np.int64)
-    else:
-        TR = TraceArrays(*tr)
-        tree_of_row = grown
-        connected = connect_nodes
+    TA = emptied_tree_in(block_a, layout_a)
+    TB = emptied_tree_in(block_b, layout_b)
     counts = np.zeros(1, dtype=np.int64)
-    ok, it, last_a, last_b = connect_kernel(
-        P, emptied_tree_in(block_a, layout_a),
-        emptied_tree_in(block_b, layout_b), seed, max_iter, knots, consts, scale, min_step, stop,
-        record, TR, tree_of_row, connected, counts)
+    if tr is None:  # decided when compiled: the branch not taken is not compiled at all
+        ok, it, last_a, last_b = connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale,
+                                                min_step, stop, None, None, None, counts)
+    else:
+        ok, it, last_a, last_b = connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale,
+                                                min_step, stop, TraceArrays(*tr), grown,
+                                                connect_nodes, counts)
     return ok, it, last_a, last_b, counts[0]
 
 
@@ -481,14 +478,13 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         grown = np.zeros(max_iter, dtype=np.int8)
         connect_nodes = np.zeros(max_iter, dtype=np.int64)
         tr = tuple(buffers)
-    else:  # no buffers to unbox: the entry makes its idle ones
+    else:  # no trace: the kernel compiled without trace code runs
         tr = grown = connect_nodes = None
     args = (problem, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout, int(seed))
     tail = (knots, consts, scale, min_step)
 
     def run(iters, stop):
-        return connect_entry(*args, int(iters), *tail, stop, bool(trace), tr, grown,
-                             connect_nodes)
+        return connect_entry(*args, int(iters), *tail, stop, tr, grown, connect_nodes)
 
     recorded = dict(setup.recorded)
     if max_time_s is None:

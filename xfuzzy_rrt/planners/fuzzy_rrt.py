@@ -72,7 +72,6 @@ from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import (
     TraceArrays,
-    idle_buffers,
     make_trace,
     record_iteration,
 )
@@ -177,20 +176,20 @@ def _interval(lo_raw, hi_raw, offset, limit_lo, limit_hi):
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, stop,
-                     record, TR):
+def fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, stop, TR):
     """Run Fuzzy-RRT; return ``(success, iterations, index of the last path node or -1)``.
 
-    With ``record`` true, row ``it - 1`` of every trace array in ``TR`` describes iteration
-    ``it``; otherwise ``TR`` (1-row buffers) is never touched. ``stop[0] != 0`` (a wall-clock
-    budget ran out) ends the run.
+    With trace arrays ``TR`` (:func:`~xfuzzy_rrt.planners.trace_record.make_trace`), row
+    ``it - 1`` of each describes iteration ``it``; ``TR`` ``None`` records nothing, and its
+    compiled loop has no trace code at all (:mod:`~xfuzzy_rrt.planners.trace_record`).
+    ``stop[0] != 0`` (a wall-clock budget ran out) ends the run.
     """
     n_arms = P.arm_first.shape[0] - 1
     n_out = knots.shape[0]
     dof = P.start.shape[0]
     # an uncounted loop (README, "No reference counting in the loops") borrows these buffers
     return _fuzzy_rrt_loop(
-        P, T, seed, max_iter, knots, consts, bounds_mode, min_step, stop, record, TR,
+        P, T, seed, max_iter, knots, consts, bounds_mode, min_step, stop, TR,
         np.empty(4, dtype=np.uint64), np.empty(4 * n_arms, dtype=np.float64),
         np.empty(n_out * n_arms, dtype=np.float64), np.empty((n_out, MAX_FIRED), dtype=np.int32),
         np.empty((n_out, MAX_FIRED), dtype=np.float64), np.empty(2 * dof, dtype=np.float64),
@@ -199,8 +198,8 @@ def fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode, min_step,
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
-def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, stop, record,
-                    TR, state, x, y, dummy_rule, dummy_w, box, sample, q_near, q_new, goal_ws):
+def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, stop, TR,
+                    state, x, y, dummy_rule, dummy_w, box, sample, q_near, q_new, goal_ws):
     """:func:`fuzzy_rrt_kernel`'s loop, given its scratch buffers."""
     seed_state(seed, state)
     n_arms = P.arm_first.shape[0] - 1
@@ -231,11 +230,11 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
             xa[2] = a_obs
             xa[3] = d_obs
             # 3. The rulebook's systems (goal bias, two bounds per joint, step).
-            if record:
+            if TR is None:  # decided when compiled
+                infer(knots, consts, xa, ya, dummy_rule, dummy_w, False)
+            else:
                 infer(knots, consts, xa, ya, TR.rule[row, n_out * a:n_out * (a + 1)],
                       TR.w[row, n_out * a:n_out * (a + 1)], True)
-            else:
-                infer(knots, consts, xa, ya, dummy_rule, dummy_w, False)
             bias_sum += ya[0]
             if ya[n_out - 1] < step_min:
                 step_min = ya[n_out - 1]
@@ -264,7 +263,7 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
         current = nearest(T, sample)
         # 6-7. Steer, certify, grow, try the goal (shared with RRT).
         outcome, new_index = extend(P, T, current, sample, step, q_near, q_new)
-        if record:
+        if TR is not None:
             record_iteration(TR, row, from_node, x, y, box, goal_sampled, sample, current,
                              q_new, outcome, new_index, T.meta[0])
         if outcome == GOAL_REACHED:
@@ -274,32 +273,28 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def fuzzy_rrt_entry(p, block, layout, seed, max_iter, knots, consts, bounds_mode, min_step,
-                    stop, record, tr):
+                    stop, tr):
     """:func:`fuzzy_rrt_kernel` with the problem and trace bundles as *plain* tuples and the
     tree as its arena, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`). ``tr``
-    ``None`` (a run that records nothing, ``record`` false): the idle one-row buffers are made
-    here (:func:`~xfuzzy_rrt.planners.trace_record.idle_buffers`: one per arm), not unboxed."""
+    ``None``: a run that records nothing, through the kernel compiled without trace code."""
     P = Problem(*p)
-    if tr is None:
-        TR = idle_buffers(P.start.shape[0], knots.shape[0], P.arm_first.shape[0] - 1)
-    else:
-        TR = TraceArrays(*tr)
+    if tr is None:  # decided when compiled: the branch not taken is not compiled at all
+        return fuzzy_rrt_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots,
+                                consts, bounds_mode, min_step, stop, None)
     return fuzzy_rrt_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots, consts,
-                            bounds_mode, min_step, stop, record, TR)
+                            bounds_mode, min_step, stop, TraceArrays(*tr))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def goal_frame_entry(p, block, layout, seed, max_iter, knots, consts, mode, min_step, stop,
-                     record, tr):
-    """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, called as above (one fuzzy
-    evaluation per iteration for all arms: one group of idle buffers)."""
+                     tr):
+    """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, called as above."""
     P = Problem(*p)
-    if tr is None:
-        TR = idle_buffers(P.start.shape[0], knots.shape[0], 1)
-    else:
-        TR = TraceArrays(*tr)
+    if tr is None:  # decided when compiled, as above
+        return goal_frame_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots,
+                                 consts, mode, min_step, stop, None)
     return goal_frame_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots, consts,
-                             mode, min_step, stop, record, TR)
+                             mode, min_step, stop, TraceArrays(*tr))
 
 
 def entry_for(mode: int):
@@ -403,24 +398,22 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     problem = (*setup.problem_head, new_work_counter())
     arena = pooled_tree(max_iter + 2, a.limits_deg, a.stop_width)
     tree, block, layout = arena.tree, arena.block, arena.layout
-    # untraced: no buffers to unbox (the entry makes its idle ones)
+    # untraced: None, and the kernel compiled without trace code runs
     buffers = tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace else None
     recorded = dict(setup.recorded)
     if max_time_s is None:
         t0 = time.perf_counter()
         ok, iterations, last = kernel(problem, block, layout, int(seed), max_iter, knots,
-                                      consts, mode, setup.min_step, NEVER_STOPPED, bool(trace),
-                                      buffers)
+                                      consts, mode, setup.min_step, NEVER_STOPPED, buffers)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
         kernel(problem, block, layout, int(seed), 0, knots, consts, mode, setup.min_step,
-               np.zeros(1, dtype=np.int64), bool(trace), buffers)
+               np.zeros(1, dtype=np.int64), buffers)
         problem[-1][0] = 0
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
             ok, iterations, last = kernel(problem, block, layout, int(seed), max_iter, knots,
-                                          consts, mode, setup.min_step, flag.array,
-                                          bool(trace), buffers)
+                                          consts, mode, setup.min_step, flag.array, buffers)
             wall = time.perf_counter() - t0
         recorded["max_time_s"] = float(setup.params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)

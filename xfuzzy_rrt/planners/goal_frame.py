@@ -167,18 +167,18 @@ def sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e):
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step, stop,
-                      record, TR):
+def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step, stop, TR):
     """Run goal-frame Fuzzy-RRT; return ``(success, iterations, index of the last path node or -1)``.
 
     Same signature as :func:`xfuzzy_rrt.planners.fuzzy_rrt.fuzzy_rrt_kernel` (``unused_mode``
-    stands where the paper's bounds mode is), so callers and traces treat both alike.
+    stands where the paper's bounds mode is; ``TR`` ``None``: no trace, and no trace code in
+    the compiled loop), so callers and traces treat both alike.
     """
     n_out = knots.shape[0]
     dof = P.start.shape[0]
     # an uncounted loop (README, "No reference counting in the loops") borrows these buffers
     return _goal_frame_loop(
-        P, T, seed, max_iter, knots, consts, min_step, stop, record, TR,
+        P, T, seed, max_iter, knots, consts, min_step, stop, TR,
         np.empty(4, dtype=np.uint64), np.empty(4, dtype=np.float64),
         np.empty(n_out, dtype=np.float64), np.empty((n_out, MAX_FIRED), dtype=np.int32),
         np.empty((n_out, MAX_FIRED), dtype=np.float64), np.empty(2 * dof, dtype=np.float64),
@@ -187,8 +187,8 @@ def goal_frame_kernel(P, T, seed, max_iter, knots, consts, unused_mode, min_step
 
 
 @nb.njit(cache=True, nogil=True, _nrt=False)
-def _goal_frame_loop(P, T, seed, max_iter, knots, consts, min_step, stop, record, TR, state, x,
-                     y, dummy_rule, dummy_w, box, sample, e, q_near, q_new):
+def _goal_frame_loop(P, T, seed, max_iter, knots, consts, min_step, stop, TR, state, x, y,
+                     dummy_rule, dummy_w, box, sample, e, q_near, q_new):
     """:func:`goal_frame_kernel`'s loop, given its scratch buffers."""
     seed_state(seed, state)
     n_out = knots.shape[0]
@@ -221,10 +221,10 @@ def _goal_frame_loop(P, T, seed, max_iter, knots, consts, min_step, stop, record
         x[1] = stagnation
         x[2] = c_deg
         x[3] = reject
-        if record:
-            infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
-        else:
+        if TR is None:  # decided when compiled (see trace_record.py)
             infer(knots, consts, x, y, dummy_rule, dummy_w, False)
+        else:
+            infer(knots, consts, x, y, TR.rule[row], TR.w[row], True)
         step = max(y[5], min_step)
         goal_sampled = sample_goal_frame(q, goal, d_goal, y, limits, state, sample, box, e)
         from_node = current
@@ -238,7 +238,7 @@ def _goal_frame_loop(P, T, seed, max_iter, knots, consts, min_step, stop, record
             if d_new < best:
                 best = d_new
                 stagnation = 0.0
-        if record:
+        if TR is not None:
             record_iteration(TR, row, from_node, x, y, box, goal_sampled, sample, current,
                              q_new, outcome, new_index, T.meta[0])
         if outcome == GOAL_REACHED:

@@ -5,8 +5,8 @@ from scratch (a scenario's arrays from the TOML model, a 10,000-node tree, thirt
 buffers that are never written when not tracing) cost as much again. Everything here is an
 exact stand-in for the fresh object: the arrays are the same numbers, the tree is emptied by
 the compiled entry before every use (:func:`~xfuzzy_rrt.planners.tree_arena.emptied_tree_in`,
-:func:`~xfuzzy_rrt.planners.tree.reset_tree`'s state). (The idle trace buffers an untraced run
-takes are made by the compiled entries: :func:`~xfuzzy_rrt.planners.trace_record.idle_buffers`.)
+:func:`~xfuzzy_rrt.planners.tree.reset_tree`'s state). (An untraced run takes no trace
+buffers at all: :mod:`~xfuzzy_rrt.planners.trace_record`.)
 Trees are per thread, so concurrent plans never share one.
 """
 

@@ -3,9 +3,15 @@ writes a row (shared by every kernel, so a trace means one thing whatever the se
 
 Buffers are preallocated in Python (``np.empty``: the kernel writes every field of every row it
 records, and untouched pages of a 10,000-row buffer then cost nothing) and travel into the
-compiled loop as one :class:`TraceArrays` record. When tracing is off the kernels get 1-row
-buffers and never touch them; the planners' entries make those in compiled code
-(:func:`idle_buffers`) instead of receiving them.
+compiled loop as one :class:`TraceArrays` record. When tracing is off a kernel gets ``None``
+instead, and numba decides ``TR is None`` when it compiles: the untraced kernel is a
+specialisation of its own, with no trace code and no trace buffers. Why: until the seventeenth
+session an untraced run took 1-row buffers (made in compiled code each call) and chose at run
+time; with the caches cold (a benchmark, or a program doing anything between plans) the
+2-joint default's kernel then took ~99.5 us against ~91.5 us now (24 `sample` problems x 10
+seeds, 512 MB evicted before each call; docs/peer-measurements.md). A trace never changes a
+plan: both specialisations make the same decisions on the same floats
+(``tests/test_tracing_leaves_the_plan_unchanged.py``).
 
 Shapes, with ``dof`` the joint-space dimension, ``groups`` the number of fuzzy evaluations per
 iteration (one per arm for the paper's workspace semantics, one for the goal-frame semantics)
@@ -41,7 +47,7 @@ class TraceArrays(NamedTuple):
 
 
 def make_trace(rows: int, dof: int, n_out: int, groups: int = 1) -> TraceArrays:
-    """Buffers for ``rows`` iterations (pass ``rows=1`` when not tracing)."""
+    """Buffers for ``rows`` iterations (a kernel that traces nothing takes ``None``)."""
     rows = max(int(rows), 1)
     return TraceArrays(
         np.empty(rows, dtype=np.int64), np.empty((rows, 4 * groups)),
@@ -50,24 +56,6 @@ def make_trace(rows: int, dof: int, n_out: int, groups: int = 1) -> TraceArrays:
         np.empty((rows, dof)), np.empty(rows, dtype=np.int8), np.empty(rows, dtype=np.int64),
         np.empty(rows, dtype=np.int64), np.empty((rows, n_out * groups, MAX_FIRED), dtype=np.int32),
         np.empty((rows, n_out * groups, MAX_FIRED)))
-
-
-@nb.njit(cache=True, nogil=True, _nrt=True)
-def idle_buffers(dof, n_out, groups):
-    """``make_trace(1, dof, n_out, groups)``, made in compiled code: the one-row buffers an
-    untraced run takes and never writes (same dtypes and shapes, so the kernel is the very
-    specialisation a traced run uses). Why made here and not passed in: an entry unboxes each
-    array argument on every call, and with the caches cold (a benchmark, or a program doing
-    anything between plans) these thirteen cost ~12 us of a 3-joint call's ~160 us (one
-    allocation each here: ~1 us)."""
-    return TraceArrays(
-        np.empty(1, dtype=np.int64), np.empty((1, 4 * groups), dtype=np.float64),
-        np.empty((1, n_out * groups), dtype=np.float64), np.empty((1, 2 * dof), dtype=np.float64),
-        np.empty(1, dtype=np.bool_), np.empty((1, dof), dtype=np.float64),
-        np.empty(1, dtype=np.int64), np.empty((1, dof), dtype=np.float64),
-        np.empty(1, dtype=np.int8), np.empty(1, dtype=np.int64), np.empty(1, dtype=np.int64),
-        np.empty((1, n_out * groups, MAX_FIRED), dtype=np.int32),
-        np.empty((1, n_out * groups, MAX_FIRED), dtype=np.float64))
 
 
 @nb.njit(cache=True, nogil=True, inline="always")

@@ -30,7 +30,6 @@ from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.planners.connect import connect_kernel
 from xfuzzy_rrt.planners.fuzzy_rrt import GOAL_FRAME, MIN_STEP_DEG, fuzzy_rrt_kernel
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
-from xfuzzy_rrt.planners.trace_record import make_trace
 from xfuzzy_rrt.planners.tree import NN_VISITS, make_tree, reset_tree
 from xfuzzy_rrt.training.memo import paper_population
 
@@ -39,7 +38,7 @@ FAILURE_REWARD = -100.0
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_step,
-                            stop, TR):
+                            stop):
     """Iterations and work of every (individual, seed) run: int64[P, R, 2].
 
     ``[..., 0]`` is the run's iterations, ``-1`` for a failed run; ``[..., 1]`` the work it
@@ -48,7 +47,7 @@ def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_ite
     the fair protocol ranks planners on).
     ``knots_b`` [P, n_out, 4, 5] and ``consts_b`` [P, n_out, 625] are decoded individuals;
     ``T`` is one preallocated tree (:func:`~xfuzzy_rrt.planners.tree.make_tree`), emptied
-    before each run; ``TR`` 1-row trace buffers the kernels never touch (``record`` is off).
+    before each run. Nothing is traced: the kernels take ``None`` for their trace arrays.
     ``bounds_mode`` is the integer the semantics' kernel takes (``Semantics.kernel_mode``;
     compiled code cannot take the semantics object, so the choice of loop stays this one
     integer test per run).
@@ -57,12 +56,10 @@ def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_ite
     n_seeds = seeds.shape[0]
     out = np.empty((n_ind, n_seeds, 2), dtype=np.int64)
     meta0 = T.meta.copy()
-    # Always False, but typed as a run-time bool (a literal ``False`` would be typed
-    # ``Literal[bool](False)``): with it, and the read-only rulebook arrays
-    # ``kernel_population`` passes, the kernels below are the very specialisations the
-    # planner compiles, so training and planning share one compiled (cached) kernel each
-    # instead of compiling two (about 100 s and 50 s each on a cold cache).
-    record = n_seeds < 0
+    # With no trace (``None``) and the read-only rulebook arrays ``kernel_population`` passes,
+    # the kernels below are the very specialisations an untraced plan compiles, so training
+    # and planning share one compiled (cached) kernel each instead of compiling two (about
+    # 100 s and 50 s each on a cold cache).
     for p in range(n_ind):
         for r in range(n_seeds):
             reset_tree(T, meta0)
@@ -70,22 +67,22 @@ def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_ite
             if bounds_mode == GOAL_FRAME:
                 ok, iterations, _ = goal_frame_kernel(
                     P, T, seeds[r], max_iter, knots_b[p], consts_b[p], bounds_mode, min_step,
-                    stop, record, TR)
+                    stop, None)
             else:
                 ok, iterations, _ = fuzzy_rrt_kernel(
                     P, T, seeds[r], max_iter, knots_b[p], consts_b[p], bounds_mode, min_step,
-                    stop, record, TR)
+                    stop, None)
             out[p, r, 0] = iterations if ok else -1
             out[p, r, 1] = P.work[0] - work0 + T.meta[NN_VISITS]
     return out
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def run_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_step, stop, TR):
+def run_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_step, stop):
     """Iterations of every (individual, seed) run: int64[P, R], ``-1`` for a failed run
     (:func:`run_population_measured` without the work column)."""
     return run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter,
-                                   min_step, stop, TR)[:, :, 0].copy()
+                                   min_step, stop)[:, :, 0].copy()
 
 
 @dataclass(frozen=True)
@@ -174,22 +171,20 @@ def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, s
     """A population's iterations through the planner's own kernel (:func:`run_population`):
     the ``population`` of a semantics with no faster evaluation (goal-frame). With
     ``measure="work"``: int64[P, R, 2], iterations and work (:func:`run_population_measured`)."""
-    buffers = make_trace(1, pr.dof, knots_b.shape[1], 1)
     knots_b, consts_b = _read_only(knots_b), _read_only(consts_b)
     if measure == "work":
         # a work counter of this call's own: Dask runs chunks in threads that share the
         # problem objects, and a shared counter would count the other thread's work too
         bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))
         return run_population_measured(bundle, tree, knots_b, consts_b, mode, seeds,
-                                       int(max_iter), MIN_STEP_DEG, np.zeros(1, dtype=np.int64),
-                                       buffers)
+                                       int(max_iter), MIN_STEP_DEG, np.zeros(1, dtype=np.int64))
     return run_population(pr.bundle, tree, knots_b, consts_b, mode, seeds, int(max_iter),
-                          MIN_STEP_DEG, np.zeros(1, dtype=np.int64), buffers)
+                          MIN_STEP_DEG, np.zeros(1, dtype=np.int64))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def connect_population_measured(P, TA, TB, knots_b, consts_b, seeds, max_iter, scale, min_step,
-                                stop, TR, grown, connect_nodes, counts):
+                                stop, counts):
     """:func:`run_population_measured` for Fuzzy-RRT-Connect (the ``goal-frame-any``
     semantics): iterations (``-1`` failed) and work of every (individual, seed) run,
     int64[P, R, 2], through the planner's own :func:`~xfuzzy_rrt.planners.connect.connect_kernel`.
@@ -205,7 +200,6 @@ def connect_population_measured(P, TA, TB, knots_b, consts_b, seeds, max_iter, s
     out = np.empty((n_ind, n_seeds, 2), dtype=np.int64)
     meta_a = TA.meta.copy()
     meta_b = TB.meta.copy()
-    record = n_seeds < 0  # a run-time False: see run_population_measured
     for p in range(n_ind):
         for r in range(n_seeds):
             reset_tree(TA, meta_a)
@@ -213,7 +207,7 @@ def connect_population_measured(P, TA, TB, knots_b, consts_b, seeds, max_iter, s
             work0 = P.work[0]
             ok, iterations, _, _ = connect_kernel(
                 P, TA, TB, seeds[r], max_iter, knots_b[p], consts_b[p], scale, min_step,
-                stop, record, TR, grown, connect_nodes, counts)
+                stop, None, None, None, counts)
             out[p, r, 0] = iterations if ok else -1
             out[p, r, 1] = P.work[0] - work0 + TA.meta[NN_VISITS] + TB.meta[NN_VISITS]
     return out
@@ -230,14 +224,13 @@ def connect_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, 
     cap = tree_capacity(max_iter)
     ta = make_tree(cap, pr.limits, stops=pr.stop_width)
     tb = make_tree(cap, pr.limits, stops=pr.stop_width)
-    buffers = make_trace(1, pr.dof, knots_b.shape[1], 1)
-    rows = (np.zeros(1, dtype=np.int8), np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
+    counts = np.zeros(1, dtype=np.int64)
     # a work counter of this call's own (Dask threads share problem objects)
     bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))
     out = connect_population_measured(
         bundle, ta, tb, _read_only(knots_b), _read_only(consts_b), seeds, int(max_iter),
         length_scale(GOAL_FRAME_ANY, pr.dof), MIN_STEP_DEG, np.zeros(1, dtype=np.int64),
-        buffers, *rows)
+        counts)
     return out if measure == "work" else out[:, :, 0].copy()
 
 

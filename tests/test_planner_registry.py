@@ -173,3 +173,39 @@ def test_reproduce_commands_name_a_rulebook_label_by_its_kind(label, cli):
     from xfuzzy_rrt.report.evidence import cli_planner
 
     assert cli_planner(label) == cli
+
+
+def test_plain_fuzzy_rrt_runs_the_any_arm_core_registered_now(problems, tmp_path):
+    # plain fuzzy-rrt on a problem that is not one 2-joint arm runs the core registered as
+    # fuzzy-rrt-connect; the API remembers it per kind, and must forget it when the registry
+    # changes (a stale core would plan with the replaced planner)
+    from xfuzzy_rrt.planners.api import plan_scenario as plan
+
+    three = tmp_path / "three.toml"
+    three.write_text('name = "three"\n[arm]\nlinks = [0.1, 0.1, 0.1]\nlink_radius = 0.005\n'
+                     '[start]\nq_deg = [0.0, 10.0, 0.0]\n[goal]\nq_deg = [60.0, -20.0, 5.0]\n')
+    scenario = load_scenario(three)
+    assert plan(scenario, "fuzzy-rrt", seed=0).planner_used == "fuzzy-rrt-connect"
+    original = registry.lookup("fuzzy-rrt-connect")
+    order = registry.planners()  # help and error text list the forms in this order
+    calls = []
+
+    def core(scenario, **kw):
+        calls.append(kw["label"])
+        return original.core_fn(scenario, **kw)
+
+    registry.unregister("fuzzy-rrt-connect")
+    try:
+        registry.register(Planner("fuzzy-rrt-connect", original.kind, original.plan,
+                                  parse=original.parse, takes_rulebook=True, traces=True,
+                                  params=original.params, core=core, fits=original.fits))
+        plan(scenario, "fuzzy-rrt", seed=0)
+        assert calls == ["fuzzy-rrt"]
+    finally:
+        registry.unregister("fuzzy-rrt-connect")
+        registry.register(original)
+        registry._ORDER[:] = order
+    assert registry.planners() == order
+    calls.clear()
+    plan(scenario, "fuzzy-rrt", seed=0)
+    assert calls == []

@@ -113,6 +113,13 @@ class Scenario:
     def joint_limits_deg(self) -> tuple[tuple[float, float], ...]:
         return tuple(lim for a in self.arms for lim in a.joint_limits_deg)
 
+    @functools.cached_property
+    def one_two_joint_arm(self) -> bool:
+        """One arm of two joints (the problems the shipped 2-joint default plans). Remembered
+        on the object: plain ``fuzzy-rrt`` reads it on every call, and a read costs no Python
+        call (each one ~3-10 us when a benchmark has evicted the caches)."""
+        return not self.more_arms and len(self.arm.links) == 2
+
     def arm_slices(self) -> tuple[slice, ...]:
         """Where each arm's angles sit in ``start_deg``, ``goal_deg`` and every path row."""
         out, k = [], 0

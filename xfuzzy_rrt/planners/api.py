@@ -76,10 +76,9 @@ def default_rulebook_dir(kind: str) -> Path:
 
 
 def is_two_joint_problem(scenario: Scenario) -> bool:
-    """One arm of two joints: the problems the shipped ``goal-frame`` rulebook was made for.
-    (Read from the fields, not ``scenario.arms``, which builds a tuple: this runs in every
-    default plan call.)"""
-    return not scenario.more_arms and len(scenario.arm.links) == 2
+    """One arm of two joints: the problems the shipped ``goal-frame`` rulebook was made for
+    (``Scenario.one_two_joint_arm``, remembered on the scenario)."""
+    return scenario.one_two_joint_arm
 
 
 def shipped_default(scenario: Scenario) -> tuple[str, Path]:
@@ -113,7 +112,7 @@ class ShippedDefault:
 
     def for_scenario(self, scenario: Scenario) -> tuple[str, Any]:
         """``(planner, loaded rulebook)`` of :func:`shipped_default` for *scenario*."""
-        if is_two_joint_problem(scenario):
+        if scenario.one_two_joint_arm:
             return "fuzzy-rrt", self.two_joint
         return ANY_ARM_PLANNER, self.any_arm
 
@@ -351,20 +350,37 @@ def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed
                              "names its own rulebook); give only one")
         rulebook = rulebook if rulebook is not None else spec.rulebook_dir
     elif rulebook is None and kind == "fuzzy-rrt":
-        # No rulebook named: the shipped default, per problem (shipped_default's rule).
+        # No rulebook named: the shipped default, per problem (shipped_default's rule, as
+        # ShippedDefault.for_scenario; written out, because this runs in every default call and
+        # a Python call costs ~3-10 us when a benchmark has evicted the caches). Without a
+        # preloaded default, rulebook stays None: that planner's own default (the rule without
+        # its ~0.1 ms rulebook-directory look-up, which the planner does anyway).
+        if not scenario.one_two_joint_arm:
+            kind = ANY_ARM_PLANNER
         if default is not None:
-            kind, rulebook = default.for_scenario(scenario)
-        else:
-            # rulebook None: that planner's own default (the rule without its ~0.1 ms
-            # rulebook-directory look-up, which the planner does anyway)
-            kind = "fuzzy-rrt" if is_two_joint_problem(scenario) else ANY_ARM_PLANNER
+            rulebook = default.two_joint if kind == "fuzzy-rrt" else default.any_arm
     elif rulebook is None and default is not None:
         rulebook = default.any_arm
-    core = (spec.planner if kind == spec.kind else _registry.lookup(kind)).core_fn
+    if kind == spec.kind:
+        core = spec.planner.core_fn
+    else:
+        core = _CORES.get(kind) or _core_of(kind)
     # the core names its result with the label (planner_used: its own kind), as rrt:tuned's
     # does: no finished result is copied to relabel it
     return core(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter, trace=trace,
                 clearance_m=clearance_m, max_time_s=max_time_s, label=spec.label)
+
+
+#: kind -> the ``core`` of its registration (:func:`_core_of`), for a label that runs another
+#: kind (plain ``fuzzy-rrt`` on a problem that is not one 2-joint arm runs Connect's); a dict
+#: read is no Python call. Forgotten when the registry changes.
+_CORES: dict = {}
+_registry.ON_CHANGE.append(_CORES.clear)
+
+
+def _core_of(kind: str):
+    core = _CORES[kind] = _registry.lookup(kind).core_fn
+    return core
 
 
 def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter, step_deg,

@@ -422,6 +422,8 @@ class _Setup(NamedTuple):
     forward_head: tuple
     #: the result's ``params`` as far as the set-up fixes them (each call copies it)
     recorded: dict
+    #: nodes per tree (:func:`tree_capacity`; kept here: one Python call less per plan)
+    capacity: int
 
 
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -439,7 +441,7 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
                 "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
     return _Setup(rb, a, margin, int(max_iter), min_step, params, knots, consts, scale,
-                  tuple(a.problem(margin))[:-1], recorded)
+                  tuple(a.problem(margin))[:-1], recorded, tree_capacity(max_iter))
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -471,7 +473,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
     work = new_work_counter()  # one count for both directions
     problem = (*setup.forward_head, work)
-    arena_a, arena_b = pooled_trees(tree_capacity(max_iter), a.limits_deg, 2, a.stop_width)
+    arena_a, arena_b = pooled_trees(setup.capacity, a.limits_deg, 2, a.stop_width)
     ta, tb = arena_a.tree, arena_b.tree
     if trace:
         buffers = make_trace(max_iter, a.dof, knots.shape[0], 1)
@@ -481,22 +483,23 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
     else:  # no trace: the kernel compiled without trace code runs
         tr = grown = connect_nodes = None
     args = (problem, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout, int(seed))
-    tail = (knots, consts, scale, min_step)
-
-    def run(iters, stop):
-        return connect_entry(*args, int(iters), *tail, stop, tr, grown, connect_nodes)
-
     recorded = dict(setup.recorded)
-    if max_time_s is None:
+    if max_time_s is None:  # the entry called here, not through a helper (one Python call less)
         t0 = time.perf_counter()
-        ok, iterations, last_a, last_b, extensions = run(max_iter, NEVER_STOPPED)
+        ok, iterations, last_a, last_b, extensions = connect_entry(
+            *args, max_iter, knots, consts, scale, min_step, NEVER_STOPPED, tr, grown,
+            connect_nodes)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        run(0, np.zeros(1, dtype=np.int64))  # the next run empties the trees again
+        # (the next run empties the trees again)
+        connect_entry(*args, 0, knots, consts, scale, min_step, np.zeros(1, dtype=np.int64), tr,
+                      grown, connect_nodes)
         work[0] = 0
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
-            ok, iterations, last_a, last_b, extensions = run(max_iter, flag.array)
+            ok, iterations, last_a, last_b, extensions = connect_entry(
+                *args, max_iter, knots, consts, scale, min_step, flag.array, tr, grown,
+                connect_nodes)
             wall = time.perf_counter() - t0
     ok = bool(ok)
     na, nb_ = int(ta.meta[0]), int(tb.meta[0])

@@ -7,9 +7,9 @@ compiled loop as one :class:`TraceArrays` record. When tracing is off a kernel g
 instead, and numba decides ``TR is None`` when it compiles: the untraced kernel is a
 specialisation of its own, with no trace code and no trace buffers. Why: until the seventeenth
 session an untraced run took 1-row buffers (made in compiled code each call) and chose at run
-time; with the caches cold (a benchmark, or a program doing anything between plans) the
-2-joint default's kernel then took ~99.5 us against ~91.5 us now (24 `sample` problems x 10
-seeds, 512 MB evicted before each call; docs/peer-measurements.md). A trace never changes a
+time; with the caches cold (a benchmark, or a program doing anything between plans) whole
+calls of the default are 1-6 % faster without them (``benchmarks/cold_calls.py``, old and new
+alternated; docs/peer-measurements.md, seventeenth session). A trace never changes a
 plan: both specialisations make the same decisions on the same floats
 (``tests/test_tracing_leaves_the_plan_unchanged.py``).
 

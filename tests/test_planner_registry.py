@@ -177,8 +177,7 @@ def test_reproduce_commands_name_a_rulebook_label_by_its_kind(label, cli):
 
 def test_plain_fuzzy_rrt_runs_the_any_arm_core_registered_now(problems, tmp_path):
     # plain fuzzy-rrt on a problem that is not one 2-joint arm runs the core registered as
-    # fuzzy-rrt-connect; the API remembers it per kind, and must forget it when the registry
-    # changes (a stale core would plan with the replaced planner)
+    # fuzzy-rrt-connect now: nothing may remember a replaced planner's core
     from xfuzzy_rrt.planners.api import plan_scenario as plan
 
     three = tmp_path / "three.toml"

@@ -350,37 +350,20 @@ def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed
                              "names its own rulebook); give only one")
         rulebook = rulebook if rulebook is not None else spec.rulebook_dir
     elif rulebook is None and kind == "fuzzy-rrt":
-        # No rulebook named: the shipped default, per problem (shipped_default's rule, as
-        # ShippedDefault.for_scenario; written out, because this runs in every default call and
-        # a Python call costs ~3-10 us when a benchmark has evicted the caches). Without a
-        # preloaded default, rulebook stays None: that planner's own default (the rule without
-        # its ~0.1 ms rulebook-directory look-up, which the planner does anyway).
-        if not scenario.one_two_joint_arm:
-            kind = ANY_ARM_PLANNER
+        # No rulebook named: the shipped default, per problem (shipped_default's rule).
         if default is not None:
-            rulebook = default.two_joint if kind == "fuzzy-rrt" else default.any_arm
+            kind, rulebook = default.for_scenario(scenario)
+        else:
+            # rulebook None: that planner's own default (the rule without its ~0.1 ms
+            # rulebook-directory look-up, which the planner does anyway)
+            kind = "fuzzy-rrt" if scenario.one_two_joint_arm else ANY_ARM_PLANNER
     elif rulebook is None and default is not None:
         rulebook = default.any_arm
-    if kind == spec.kind:
-        core = spec.planner.core_fn
-    else:
-        core = _CORES.get(kind) or _core_of(kind)
+    core = (spec.planner if kind == spec.kind else _registry.lookup(kind)).core_fn
     # the core names its result with the label (planner_used: its own kind), as rrt:tuned's
     # does: no finished result is copied to relabel it
     return core(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter, trace=trace,
                 clearance_m=clearance_m, max_time_s=max_time_s, label=spec.label)
-
-
-#: kind -> the ``core`` of its registration (:func:`_core_of`), for a label that runs another
-#: kind (plain ``fuzzy-rrt`` on a problem that is not one 2-joint arm runs Connect's); a dict
-#: read is no Python call. Forgotten when the registry changes.
-_CORES: dict = {}
-_registry.ON_CHANGE.append(_CORES.clear)
-
-
-def _core_of(kind: str):
-    core = _CORES[kind] = _registry.lookup(kind).core_fn
-    return core
 
 
 def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter, step_deg,

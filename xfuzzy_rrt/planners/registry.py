@@ -128,9 +128,6 @@ class Planner:
 _EXACT: dict[str, Planner] = {}
 _PREFIX: dict[str, Planner] = {}
 _ORDER: list[Planner] = []
-#: Called with no argument after every :func:`register` and :func:`unregister`: what callers
-#: remembered from the registry (``api._CORES``) is forgotten.
-ON_CHANGE: list[Callable[[], None]] = []
 
 
 def register(planner: Planner) -> Planner:
@@ -141,8 +138,6 @@ def register(planner: Planner) -> Planner:
         raise ValueError(f"planner label {planner.form!r} is already registered")
     table[planner.label] = planner
     _ORDER.append(planner)
-    for forget in ON_CHANGE:
-        forget()
     return planner
 
 
@@ -150,8 +145,6 @@ def unregister(label: str) -> None:
     """Remove the form registered under ``label`` (exact label or prefix with its colon)."""
     planner = _EXACT.pop(label, None) or _PREFIX.pop(label)
     _ORDER.remove(planner)
-    for forget in ON_CHANGE:
-        forget()
 
 
 def lookup(name: str) -> Planner | None:

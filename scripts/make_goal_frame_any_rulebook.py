@@ -7,7 +7,9 @@ the same genome; rulebooks/README.md has the command).
 Why this is a faithful starting point: ``goal-frame-any`` measures every joint-space length in
 normalised degrees (Euclidean degrees divided by ``sqrt(N/2)``, ``N`` joints in all; see
 :mod:`xfuzzy_rrt.fuzzy.semantics`), which are exactly goal-frame's degrees at two joints, and
-its input and output ranges are goal-frame's 2-joint ranges. So the same knots and rule
+its input and output ranges are goal-frame's 2-joint ranges (but for the step: goal-frame's
+reaches 360 since the eighteenth session, goal-frame-any's stays at 120, and longer steps are
+clipped; the provenance counts them). So the same knots and rule
 constants make the same decisions at two joints and the *same per-joint* decisions at any
 other number of joints: a step of 15 normalised degrees moves each of N joints about as far as
 a 15-degree step moves each of two. Nothing here was trained for N > 2; the shipped
@@ -26,6 +28,8 @@ import datetime as dt
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from xfuzzy_rrt.fuzzy import semantics as sem
 from xfuzzy_rrt.fuzzy.rulebook import Rulebook, load_rulebook, rulebooks_dir, save_rulebook
 
@@ -43,6 +47,12 @@ def main(argv: list[str] | None = None) -> int:
               f"{src.semantics.name} at dof {src.dof}", file=sys.stderr)
         return 2
     knots, consts = src.arrays()
+    # goal-frame's 2-joint steps reach 360 since the eighteenth session; goal-frame-any's stay
+    # at the [0, 120] it was trained with, so longer steps are clipped (and counted)
+    lo = np.array([sem.GOAL_FRAME_ANY.output_ranges[o][0] for o in sem.GOAL_FRAME_ANY.outputs])
+    hi = np.array([sem.GOAL_FRAME_ANY.output_ranges[o][1] for o in sem.GOAL_FRAME_ANY.outputs])
+    clipped = int(((consts < lo[:, None]) | (consts > hi[:, None])).sum())
+    consts = np.clip(consts, lo[:, None], hi[:, None])
     command = "python scripts/make_goal_frame_any_rulebook.py" + "".join(
         f" {a}" for a in (argv if argv is not None else sys.argv[1:]))
     rb = Rulebook.from_arrays(
@@ -54,7 +64,9 @@ def main(argv: list[str] | None = None) -> int:
         provenance={"kind": "derived", "command": command, "date": args.date,
                     "source": src.name, "source_sha256": src.sha256,
                     "method": "knots and rule constants copied; lengths reinterpreted as "
-                              "Euclidean joint-space degrees / sqrt(N/2)"},
+                              "Euclidean joint-space degrees / sqrt(N/2)"
+                              + (f"; {clipped} rule constant(s) clipped to goal-frame-any's "
+                                 "output ranges" if clipped else "")},
     )
     out = save_rulebook(rb, args.out)
     print(f"wrote {out} (sha256 {load_rulebook(out).sha256[:12]})")

@@ -55,22 +55,35 @@ def goal_frame_read_as_any(tmp_path_factory):
 
     from conftest import PROJECT
 
-    out = tmp_path_factory.mktemp("any") / "goal-frame-read-as-any"
+    from xfuzzy_rrt.fuzzy.rulebook import Rulebook, save_rulebook
+
+    # the shipped goal-frame with its steps kept to goal-frame-any's [0, 120] (it may step up
+    # to 360; the script clips longer steps, which would then decide differently)
+    root = tmp_path_factory.mktemp("any")
+    shipped = load_rulebook(rulebooks_dir() / "goal-frame")
+    knots, consts = shipped.arrays()
+    consts = consts.copy()
+    consts[5] = np.minimum(consts[5], 120.0)
+    source = save_rulebook(Rulebook.from_arrays(
+        knots, consts, name="goal-frame-short-steps", bounds_mode=None,
+        semantics=shipped.semantics, provenance={"kind": "test"}), root / "goal-frame-short-steps")
+    out = root / "goal-frame-read-as-any"
     proc = subprocess.run([sys.executable, str(PROJECT / "scripts" /
                                                 "make_goal_frame_any_rulebook.py"),
-                           "--out", str(out), "--date", "2026-12-04"],
+                           "--source", str(source), "--out", str(out), "--date", "2026-12-04"],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
-    return out
+    return source, out
 
 
 @pytest.mark.parametrize("path", TWO_JOINTS, ids=lambda p: p.stem)
 def test_at_two_joints_the_dof_free_semantics_decides_exactly_as_goal_frame(
         path, goal_frame_read_as_any):
     s = load_scenario(path)
+    source, derived = goal_frame_read_as_any
     for seed in range(3):
-        a = plan_scenario(s, f"fuzzy-rrt-connect:{goal_frame_read_as_any}", seed=seed)
-        b = plan_scenario(s, "fuzzy-rrt-connect:goal-frame", seed=seed)
+        a = plan_scenario(s, f"fuzzy-rrt-connect:{derived}", seed=seed)
+        b = plan_scenario(s, f"fuzzy-rrt-connect:{source}", seed=seed)
         assert a.rulebook == "goal-frame-read-as-any" and a.params["length_scale"] == 1.0
         assert a.path_deg.tobytes() == b.path_deg.tobytes()
         assert a.tree_nodes_deg.tobytes() == b.tree_nodes_deg.tobytes()

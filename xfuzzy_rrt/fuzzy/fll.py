@@ -237,13 +237,13 @@ def parse_fll(data: bytes, file: str, expected_output: str,
         if dfz and dfz[1].split()[0] != "WeightedAverage":
             problem(dfz[0], f"defuzzifier {dfz[1]!r} is not supported (needs WeightedAverage)")
 
-    def check_range(v: _Var, expected: tuple[float, float]) -> None:
+    def check_range(v: _Var, expected: tuple[float, float], earlier=()) -> None:
         rng = v.props.get("range")
         if rng is None:
             problem(v.line, f"{v.name}: missing range")
             return
         vals = [_float(x) for x in rng[1].split()]
-        if len(vals) != 2 or tuple(vals) != expected:
+        if len(vals) != 2 or (tuple(vals) != expected and tuple(vals) not in earlier):
             problem(rng[0], f"range of {v.name} must be {num(expected[0])} {num(expected[1])}, got {rng[1]}")
 
     partitions: dict[str, InputPartition] = {}
@@ -259,7 +259,8 @@ def parse_fll(data: bytes, file: str, expected_output: str,
     consts: list[float | None] = [None] * N_RULES
     if outputs and outputs[0].name == expected_output:
         out = outputs[0]
-        check_range(out, sem.output_ranges[expected_output])
+        check_range(out, sem.output_ranges[expected_output],
+                    sem.earlier_output_ranges.get(expected_output, ()))
         values: dict[str, float] = {}
         for n, tname, ttype, params in out.terms:
             value = _float(params[0]) if ttype == "Constant" and len(params) == 1 else None

@@ -44,12 +44,16 @@ rulebook changes. What depends on ``N``:
   its dimension); only ``joint_dist_to_goal``'s range grows to ``[0, 180*sqrt(2N)]`` degrees,
   the diagonal of a joint space of N joints of 360° each (scaled so that N = 2 gives exactly
   the 360 it always had). For several arms, N is the total number of joints planned together.
+  ``step_deg`` spans [0, 360] at 2 joints and the [0, 120] the N-joint rulebooks were trained
+  with at more (the 2-joint range grew in the eighteenth session; a 2-joint file that declares
+  [0, 120] still loads: :attr:`Semantics.earlier_output_ranges`).
 
 ``goal-frame-any`` — goal-frame for any arm (manifest ``dof = "any"``; :attr:`Semantics.dof_free`):
 the same four inputs and six outputs, renamed (input names are unique across semantics) and
 with every joint-space length (distance, clearance, ahead, behind, side, step) in *normalised
 degrees*: Euclidean joint-space degrees divided by ``sqrt(N/2)`` (:func:`length_scale`). At
-N = 2 every number is goal-frame's; at other N the ranges still hold (the distance range
+N = 2 every number is goal-frame's (but steps span [0, 120], as it was trained); at other N
+the ranges still hold (the distance range
 ``180*sqrt(2N)`` normalises to 360), so one rulebook plans 2 to 7 joints and several arms.
 Only Fuzzy-RRT-Connect (:mod:`xfuzzy_rrt.planners.connect`) plans with it, and training
 (``train --bounds goal-frame-any``) runs that planner, on problems of any DOF mixed.
@@ -115,8 +119,15 @@ class Semantics:
     #: The planner label that plans with it when nothing else is said.
     planner: str = "fuzzy-rrt"
     #: Other semantics whose (2-DOF) rulebooks may seed a training of this one: the same
-    #: inputs, outputs and ranges, so the same genome (:meth:`can_seed_from`).
+    #: inputs and outputs, and ranges that encode into the same genome (constants outside
+    #: this semantics' range are clipped to it: :func:`xfuzzy_rrt.training.genome.encode`;
+    #: :meth:`can_seed_from`).
     seeded_by: tuple[str, ...] = ()
+    #: Output ranges this semantics had before (output -> ranges): a file that declares one of
+    #: them still loads (its constants lie inside today's range, so they mean what they
+    #: meant) and is written back with today's range.
+    earlier_output_ranges: Mapping[str, tuple[tuple[float, float], ...]] = field(
+        default_factory=lambda: MappingProxyType({}))
 
     def can_seed_from(self, name: str) -> bool:
         """May a rulebook of semantics *name* seed a training of this one?"""
@@ -173,15 +184,22 @@ PAPER = Semantics(
     per_arm=True,
 )
 
+#: goal-frame's output ranges before the eighteenth session (steps up to 120 degrees).
+_GOAL_FRAME_OUTPUTS = {"goal_bias": (0.0, 1.0), "uniform_share": (0.0, 1.0),
+                       "ahead_deg": (0.0, 360.0), "behind_deg": (0.0, 360.0),
+                       "side_deg": (0.0, 180.0), "step_deg": (0.0, 120.0)}
+
 GOAL_FRAME = Semantics(
     name="goal-frame",
     inputs=("joint_dist_to_goal", "stagnation", "clearance_deg", "reject_rate"),
     outputs=("goal_bias", "uniform_share", "ahead_deg", "behind_deg", "side_deg", "step_deg"),
     input_ranges=_ro({"joint_dist_to_goal": (0.0, 360.0), "stagnation": (0.0, 200.0),
                       "clearance_deg": (0.0, 30.0), "reject_rate": (0.0, 1.0)}),
-    output_ranges=_ro({"goal_bias": (0.0, 1.0), "uniform_share": (0.0, 1.0),
-                       "ahead_deg": (0.0, 360.0), "behind_deg": (0.0, 360.0),
-                       "side_deg": (0.0, 180.0), "step_deg": (0.0, 120.0)}),
+    # step_deg up to 360 (any step the box can ask for) since the eighteenth session: at 120
+    # (before) 250 of the trained default's 625 step rules sat on the cap, and the tuned
+    # RRT's best step is 180 (docs/peer-measurements.md). The N-joint goal-frame rulebooks and
+    # goal-frame-any were trained with 120 and keep it (_goal_frame_at, GOAL_FRAME_ANY).
+    output_ranges=_ro({**_GOAL_FRAME_OUTPUTS, "step_deg": (0.0, 360.0)}),
     units=_ro({"joint_dist_to_goal": "deg", "stagnation": "iterations", "clearance_deg": "deg",
                "reject_rate": "", "goal_bias": "", "uniform_share": "", "ahead_deg": "deg",
                "behind_deg": "deg", "side_deg": "deg", "step_deg": "deg"}),
@@ -202,6 +220,7 @@ GOAL_FRAME = Semantics(
     kernel="xfuzzy_rrt.planners.fuzzy_rrt:goal_frame_entry",
     population="xfuzzy_rrt.training.evaluate:kernel_population",
     measures=("iterations", "work"),
+    earlier_output_ranges=_ro({"step_deg": ((0.0, 120.0),)}),
 )
 
 #: Joint-space lengths of ``goal-frame-any`` are Euclidean degrees divided by ``sqrt(N / 2)``
@@ -216,7 +235,7 @@ GOAL_FRAME_ANY = Semantics(
     outputs=GOAL_FRAME.outputs,
     input_ranges=_ro({"norm_dist_to_goal": (0.0, 360.0), "stall": (0.0, 200.0),
                       "norm_clearance": (0.0, 30.0), "reject_share": (0.0, 1.0)}),
-    output_ranges=GOAL_FRAME.output_ranges,
+    output_ranges=_ro(_GOAL_FRAME_OUTPUTS),
     units=_ro({"norm_dist_to_goal": NORM_UNIT, "stall": "iterations",
                "norm_clearance": NORM_UNIT, "reject_share": "", "goal_bias": "",
                "uniform_share": "", "ahead_deg": NORM_UNIT, "behind_deg": NORM_UNIT,
@@ -240,7 +259,8 @@ GOAL_FRAME_ANY = Semantics(
     population="xfuzzy_rrt.training.evaluate:connect_population",
     measures=("iterations", "work"),
     planner="fuzzy-rrt-connect",
-    # goal-frame's lengths are its normalised degrees at 2 joints: the same genome
+    # goal-frame's lengths are its normalised degrees at 2 joints: the same genome (a
+    # 2-joint goal-frame step above 120 is clipped to 120)
     seeded_by=("goal-frame",),
 )
 
@@ -304,7 +324,10 @@ def _paper_at(dof: int) -> Semantics:
 def _goal_frame_at(dof: int) -> Semantics:
     ranges = dict(GOAL_FRAME.input_ranges)
     ranges["joint_dist_to_goal"] = joint_dist_range(dof)
-    return replace(GOAL_FRAME, input_ranges=_ro(ranges),
+    # steps up to 120 as the shipped N-joint rulebooks were trained (only the 2-joint default
+    # was trained again with the wider range)
+    return replace(GOAL_FRAME, input_ranges=_ro(ranges), output_ranges=_ro(_GOAL_FRAME_OUTPUTS),
+                   earlier_output_ranges=_ro({}),
                    summary=f"{GOAL_FRAME.summary} ({dof} joints in all)", dof=dof)
 
 

@@ -233,6 +233,9 @@ class _State:
     # labels of rule lines that were reported as broken: not reported again as "missing"
     attempted: set[int] = field(default_factory=set)
     end_line: int | None = None
+    # the output range the file declares (today's, or one the semantics had before), which
+    # its rule constants must keep to
+    declared: tuple[float, float] | None = None
 
     def problem(self, line: int | None, message: str) -> None:
         self.problems.append((self.file, line, message))
@@ -322,14 +325,17 @@ def _statement(st: _State, n: int, text: str) -> None:
         st.problem(n, f"unknown statement {key!r} (expected format, output, input, terms, peaks, a rule or end)")
 
 
-def _range_problem(words: list[str], expected: tuple[float, float], what: str) -> str | None:
-    """Check ``... range LO HI`` in words[2:]; return a problem or None."""
+def _range_problem(words: list[str], expected: tuple[float, float], what: str,
+                   earlier: tuple[tuple[float, float], ...] = ()) -> str | None:
+    """Check ``... range LO HI`` in words[2:]; return a problem or None. A range in *earlier*
+    (one the semantics had before: :attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.
+    earlier_output_ranges`) is accepted too."""
     if len(words) != 5 or words[2] != "range":
         return f"expected '{words[0]} {what} range LO HI'"
     lo, hi = _parse_float(words[3]), _parse_float(words[4])
     if lo is None or hi is None:
         return f"range of {what} must be two finite numbers, got {words[3]!r} {words[4]!r}"
-    if (lo, hi) != expected:
+    if (lo, hi) != expected and (lo, hi) not in earlier:
         return f"range of {what} must be {fnum(expected[0])} {fnum(expected[1])} (SPEC.md), got {words[3]} {words[4]}"
     return None
 
@@ -343,9 +349,12 @@ def _output(st: _State, n: int, words: list[str]) -> None:
     if name != st.expected_output:
         st.problem(n, f"wrong output variable {name!r}: this file describes {st.expected_output!r}")
         return
-    problem = _range_problem(words, st.sem.output_ranges[name], name)
+    problem = _range_problem(words, st.sem.output_ranges[name], name,
+                             st.sem.earlier_output_ranges.get(name, ()))
     if problem:
         st.problem(n, problem)
+    else:
+        st.declared = (_parse_float(words[3]), _parse_float(words[4]))
     st.output_ok = True
 
 
@@ -480,7 +489,7 @@ def _rule(st: _State, n: int, text: str) -> None:
     if out != st.expected_output:
         st.problem(n, f"rule concludes {out!r} but this file describes {st.expected_output!r}")
     value = _parse_float(m.group("value"))
-    lo, hi = st.sem.output_ranges[st.expected_output]
+    lo, hi = st.declared or st.sem.output_ranges[st.expected_output]
     if value is None:
         st.problem(n, f"consequent {m.group('value')!r} is not a finite number")
     elif not lo <= value <= hi:

@@ -93,14 +93,18 @@ def test_any_other_step_range_is_still_refused(tmp_path):
         load_rulebook(root)
 
 
+def _declare_old_fll_step_range(fll_dir) -> None:
+    """Make ``step_deg.fll``'s output variable declare the earlier range 0 120."""
+    step = fll_dir / "step_deg.fll"
+    head, out = step.read_text().split("OutputVariable:")
+    assert "range: 0 360" in out
+    step.write_text(head + "OutputVariable:" + out.replace("range: 0 360", "range: 0 120", 1))
+
+
 def test_the_earlier_range_is_read_from_fuzzylite_too(tmp_path):
     rb = _rulebook(90.0)
     export_fll(rb, tmp_path / "fll")
-    step = tmp_path / "fll" / "step_deg.fll"
-    text = step.read_text()
-    declared = [line for line in text.splitlines() if line.strip().startswith("range")]
-    assert any("360" in line for line in declared), declared
-    step.write_text(text.replace("360.000", "120.000").replace("360.0", "120.0"))
+    _declare_old_fll_step_range(tmp_path / "fll")
     back = import_fll(tmp_path / "fll")
     assert np.array_equal(back.arrays()[1], rb.arrays()[1])
 
@@ -111,3 +115,11 @@ def test_the_genome_spans_360_so_a_training_can_reach_it():
     genome = encode(knots, consts, "goal-frame")
     _, back = decode(genome, "goal-frame")
     assert math.isclose(back[0, 5, 0], 300.0, rel_tol=1e-12)
+
+
+def test_a_fuzzylite_constant_outside_its_declared_earlier_range_is_refused(tmp_path):
+    export_fll(_rulebook(150.0), tmp_path / "fll")
+    _declare_old_fll_step_range(tmp_path / "fll")
+    with pytest.raises(RulebookError, match=r"constant 150(\.0+)? outside the output range "
+                                            r"\[0\.0, 120\.0\]"):
+        import_fll(tmp_path / "fll")

@@ -237,14 +237,18 @@ def parse_fll(data: bytes, file: str, expected_output: str,
         if dfz and dfz[1].split()[0] != "WeightedAverage":
             problem(dfz[0], f"defuzzifier {dfz[1]!r} is not supported (needs WeightedAverage)")
 
-    def check_range(v: _Var, expected: tuple[float, float], earlier=()) -> None:
+    def check_range(v: _Var, expected: tuple[float, float], earlier=()) -> tuple[float, float]:
+        """Check *v*'s declared range (today's, or one in *earlier*); return the range its
+        values must keep to (the declared one when it is valid, else *expected*)."""
         rng = v.props.get("range")
         if rng is None:
             problem(v.line, f"{v.name}: missing range")
-            return
+            return expected
         vals = [_float(x) for x in rng[1].split()]
         if len(vals) != 2 or (tuple(vals) != expected and tuple(vals) not in earlier):
             problem(rng[0], f"range of {v.name} must be {num(expected[0])} {num(expected[1])}, got {rng[1]}")
+            return expected
+        return (vals[0], vals[1])
 
     partitions: dict[str, InputPartition] = {}
     for name in sem.inputs:
@@ -259,15 +263,14 @@ def parse_fll(data: bytes, file: str, expected_output: str,
     consts: list[float | None] = [None] * N_RULES
     if outputs and outputs[0].name == expected_output:
         out = outputs[0]
-        check_range(out, sem.output_ranges[expected_output],
-                    sem.earlier_output_ranges.get(expected_output, ()))
+        lo, hi = check_range(out, sem.output_ranges[expected_output],
+                             sem.earlier_output_ranges.get(expected_output, ()))
         values: dict[str, float] = {}
         for n, tname, ttype, params in out.terms:
             value = _float(params[0]) if ttype == "Constant" and len(params) == 1 else None
             if value is None or not math.isfinite(value):
                 problem(n, f"output term {tname!r} must be 'Constant VALUE' with a finite value")
                 continue
-            lo, hi = sem.output_ranges[expected_output]
             if not lo <= value <= hi:
                 problem(n, f"constant {params[0]} outside the output range [{lo!r}, {hi!r}]")
                 continue

@@ -110,6 +110,31 @@ def test_results_do_not_depend_on_the_number_of_workers(scenarios):
     assert one.runs[cols].to_csv(index=False) == two.runs[cols].to_csv(index=False)
 
 
+def test_pooled_jobs_name_their_scenario_and_rulebook_instead_of_carrying_them(scenarios,
+                                                                              monkeypatch):
+    # a job that carried them would arrive as new objects in the worker and miss every set-up
+    # remembered for the ones it planned with, inside each run's time_total_s
+    from xfuzzy_rrt.bench import runner
+
+    sent = []
+    real = runner._run_pool
+
+    def spy(jobs, workers, init_args, progress):
+        sent.append((jobs, init_args))
+        return real(jobs, workers, init_args, progress)
+
+    monkeypatch.setattr(runner, "_run_pool", spy)
+    kw = dict(runs=3, seed=5, max_iter=2000)
+    two = runner.run_benchmark(scenarios[:2], ["rrt", "fuzzy-rrt"], workers=2, **kw)
+    (jobs, init_args), = sent
+    assert len(jobs) == 12 and all(type(j) is tuple and len(j) == 5 for j in jobs)
+    assert {type(v) for j in jobs for v in j} <= {int, str, bool}
+    assert init_args[1] == list(scenarios[:2])  # every scenario, once per worker
+    one = runner.run_benchmark(scenarios[:2], ["rrt", "fuzzy-rrt"], workers=1, **kw)
+    cols = [c for c in one.runs.columns if c not in ("wall_s", "time_first_s", "time_total_s")]
+    assert one.runs[cols].to_csv(index=False) == two.runs[cols].to_csv(index=False)
+
+
 def test_progress_is_reported_for_every_run_in_order(scenarios):
     from xfuzzy_rrt.bench.runner import run_benchmark
 

@@ -146,10 +146,8 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     # Plain fuzzy-rrt runs another planner on a problem that is not one 2-joint arm, so the
     # first problem of the other kind warms up too.
     if scenarios:
-        from xfuzzy_rrt.planners.api import is_two_joint_problem
-
-        kind = is_two_joint_problem(scenarios[0])
-        warm = [scenarios[0], *[s for s in scenarios if is_two_joint_problem(s) != kind][:1]]
+        kind = scenarios[0].one_two_joint_arm
+        warm = [scenarios[0], *[s for s in scenarios if s.one_two_joint_arm != kind][:1]]
         for sc in warm:
             for _label, planner, rb in entries:
                 _one(sc, planner, rb, seed, min(max_iter, 100), clearance_m)

@@ -232,13 +232,13 @@ def ran_rulebooks(scenarios: list[Scenario], rulebooks: dict[str, Any],
     under :data:`~xfuzzy_rrt.planners.api.ANY_ARM_KEY` when another problem is not (under
     ``fuzzy-rrt`` itself when no problem is)."""
     from xfuzzy_rrt.planners.api import (ANY_ARM_KEY, ANY_ARM_PLANNER, ShippedDefault,
-                                         default_rulebook_dir, is_two_joint_problem)
+                                         default_rulebook_dir)
 
     shipped = jobs_rb.get("fuzzy-rrt")
     if not isinstance(shipped, ShippedDefault):
         return dict(rulebooks), dict(dirs)
-    two = any(is_two_joint_problem(s) for s in scenarios)
-    other = not all(is_two_joint_problem(s) for s in scenarios)
+    two = any(s.one_two_joint_arm for s in scenarios)
+    other = not all(s.one_two_joint_arm for s in scenarios)
     any_dir = str(default_rulebook_dir(ANY_ARM_PLANNER).resolve())
     books, where = {}, {}
     for label, rb in rulebooks.items():
@@ -267,10 +267,8 @@ def _warm_up(scenarios: list[Scenario], planners: list[str], rulebooks: dict[str
 
 
 def _warm_up_scenarios(scenarios: list[Scenario]) -> list[Scenario]:
-    from xfuzzy_rrt.planners.api import is_two_joint_problem
-
-    first = is_two_joint_problem(scenarios[0])
-    other = next((s for s in scenarios if is_two_joint_problem(s) != first), None)
+    first = scenarios[0].one_two_joint_arm
+    other = next((s for s in scenarios if s.one_two_joint_arm != first), None)
     return [scenarios[0]] + ([other] if other is not None else [])
 
 
@@ -289,15 +287,33 @@ def _die_with_parent(parent: int) -> None:
         os._exit(1)
 
 
+#: A worker's scenarios and rulebooks, received once at start-up (:func:`_worker_init`).
+_WORKER: dict[str, Any] = {}
+
+
 def _worker_init(parent: int, scenarios: list[Scenario], planners: list[str],
-                 rulebooks: dict[str, Any]) -> None:
+                 rulebooks: dict[str, Any], warm: list[int]) -> None:
     """Worker start-up: die with the parent, leave Ctrl-C to it (it cancels the pool and
-    reports once; a worker's KeyboardInterrupt traceback is noise), then warm up."""
+    reports once; a worker's KeyboardInterrupt traceback is noise), keep the scenarios and
+    rulebooks the jobs name (:func:`_pooled_run`), then warm up."""
     _die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(AttributeError, ValueError):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-    _warm_up(scenarios, planners, rulebooks)
+    _WORKER.update(scenarios=scenarios, rulebooks=rulebooks)
+    _warm_up([scenarios[k] for k in warm], planners, rulebooks)
+
+
+def _pooled_run(key: tuple[int, str, int, int, bool]) -> tuple[PlanResult, dict[str, Any]]:
+    """One job on a worker, named by ``(scenario index, planner, seed, max_iter, shortcut)``.
+
+    Why not the job itself: a pickled job arrives as new scenario and rulebook objects, which
+    miss every set-up remembered for the ones the worker already planned with (~50 us a call
+    for a scenario, milliseconds for a rulebook), inside the ``time_total_s`` a bench reports;
+    a worker keeps one object of each for all its jobs."""
+    k, planner, seed, max_iter, shortcut = key
+    return _one_run(_Job(_WORKER["scenarios"][k], planner, _WORKER["rulebooks"].get(planner),
+                         seed, max_iter, shortcut))
 
 
 def _median_run_seed(group: pd.DataFrame) -> int | None:
@@ -353,7 +369,10 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
             if progress is not None:
                 progress(len(outputs), len(jobs))
     else:
-        outputs = _run_pool(jobs, workers, (os.getpid(), warm, planners, jobs_rb), progress)
+        index = {id(s): k for k, s in enumerate(scenarios)}
+        keys = [(index[id(j.scenario)], j.planner, j.seed, j.max_iter, j.shortcut) for j in jobs]
+        outputs = _run_pool(keys, workers, (os.getpid(), scenarios, planners, jobs_rb,
+                                            [index[id(s)] for s in warm]), progress)
     columns = RUN_COLUMNS + (["cost_short_deg"] if shortcut else [])
     runs_df = pd.DataFrame([row for _, row in outputs], columns=columns)
     for col in ("success", "found", "certified"):
@@ -401,8 +420,8 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
                        rulebooks=dict(rulebooks), worst_examples=worst)
 
 
-def _run_pool(jobs: list[_Job], workers: int, init_args: tuple, progress: Progress | None):
-    """Run ``jobs`` on worker processes, results in job order.
+def _run_pool(jobs: list[tuple], workers: int, init_args: tuple, progress: Progress | None):
+    """Run ``jobs`` (:func:`_pooled_run`'s keys) on worker processes, results in job order.
 
     Ctrl-C: workers ignore SIGINT (:func:`_worker_init`; SIGINT is also blocked while they are
     forked, so none can catch it before it runs), the parent cancels what has not started and
@@ -418,7 +437,7 @@ def _run_pool(jobs: list[_Job], workers: int, init_args: tuple, progress: Progre
     try:
         try:
             chunk = max(1, min(16, len(jobs) // (8 * workers)))
-            results = pool.map(_one_run, jobs, chunksize=chunk)  # forks the workers now
+            results = pool.map(_pooled_run, jobs, chunksize=chunk)  # forks the workers now
         finally:
             if blocked:
                 signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})

@@ -81,9 +81,9 @@ def evaluate(
     if len(set(labels)) != len(labels):
         raise InputError("--rulebook", "two planners share a name; give each rulebook once")
     scenarios = [load_scenario(f) for f in scenario_files(problems)]
-    from xfuzzy_rrt.planners.api import is_two_joint_problem, load_shipped_default
+    from xfuzzy_rrt.planners.api import load_shipped_default
 
-    if not named and not all(is_two_joint_problem(sc) for sc in scenarios):
+    if not named and not all(sc.one_two_joint_arm for sc in scenarios):
         # No rulebook named and not every problem is one 2-joint arm: the shipped default per
         # problem (goal-frame there, fuzzy-rrt-connect with goal-frame-any elsewhere), under
         # the label plain fuzzy-rrt; runs.csv's planner_used and rulebook say which ran.

@@ -75,12 +75,6 @@ def default_rulebook_dir(kind: str) -> Path:
     return default_rulebook_path()
 
 
-def is_two_joint_problem(scenario: Scenario) -> bool:
-    """One arm of two joints: the problems the shipped ``goal-frame`` rulebook was made for
-    (``Scenario.one_two_joint_arm``, remembered on the scenario)."""
-    return scenario.one_two_joint_arm
-
-
 def shipped_default(scenario: Scenario) -> tuple[str, Path]:
     """``(planner, rulebook directory)`` that plain ``fuzzy-rrt`` runs on *scenario* when the
     user names no rulebook (no ``--rulebook``, no ``fuzzy-rrt:NAME``, ``rulebook=None``).
@@ -95,7 +89,7 @@ def shipped_default(scenario: Scenario) -> tuple[str, Path]:
     two 3-joint arms 2.09x against ``goal-frame-dual3``'s 1.25x).
     Only this default adapts: a rulebook the user names that does not fit stays an error.
     """
-    if is_two_joint_problem(scenario):
+    if scenario.one_two_joint_arm:
         return "fuzzy-rrt", default_rulebook_dir("fuzzy-rrt")
     return ANY_ARM_PLANNER, default_rulebook_dir(ANY_ARM_PLANNER)
 

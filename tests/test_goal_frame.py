@@ -227,7 +227,8 @@ def _train(cwd: Path, *extra: str, fitness: str = "log-ratio") -> subprocess.Com
 
 
 @pytest.mark.parametrize("fitness,baseline", [("log-ratio", "baseline_iterations"),
-                                              ("work-cvar", "baseline_work")])
+                                              ("work-cvar", "baseline_work"),
+                                              ("work-cost-cvar", "baseline_cost_deg")])
 def test_training_with_validation_reproduces_across_workers_and_dask(tmp_path, fitness, baseline):
     distributed = pytest.importorskip("distributed")
     outputs = {}

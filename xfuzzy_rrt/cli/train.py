@@ -65,14 +65,15 @@ def train(
     population: int = typer.Option(400, "--population", help="Individuals per generation (paper: 400)."),
     generations: int = typer.Option(50, "--generations", help="Maximum generations (paper: 50)."),
     runs_per_eval: int = typer.Option(5, "--runs-per-eval", help="Planner runs per scenario per individual (paper: 5)."),
-    target_fitness: Optional[float] = typer.Option(None, "--target-fitness", help="Stop when the best fitness reaches this (default: the paper's 9750 with --fitness paper; never with log-ratio or work-cvar)."),
+    target_fitness: Optional[float] = typer.Option(None, "--target-fitness", help="Stop when the best fitness reaches this (default: the paper's 9750 with --fitness paper; never with log-ratio, work-cvar or work-cost-cvar)."),
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Seed: the result depends only on it and the inputs."),
     workers: Optional[int] = typer.Option(None, "--workers", callback=check_workers_option, help="Local worker processes (default: all cores; 1 = in-process)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address (tcp://HOST:PORT): evaluate there."),
     out: Path = typer.Option(..., "--out", help="Rulebook directory to write (also history.csv and checkpoint/)."),
     resume: bool = typer.Option(False, "--resume", help="Continue from OUT/checkpoint after an interruption."),
     bounds: str = typer.Option("absolute", "--bounds", help="Planner semantics: absolute or relative bounds (the paper's semantics), goal-frame, or goal-frame-any (one rulebook for any arm, trained with Fuzzy-RRT-Connect on scenarios of any DOF mixed)."),
-    fitness: str = typer.Option("paper", "--fitness", help="paper (mean of 10000 - iterations, -100 on failure), log-ratio (mean log of RRT's median / iterations per problem) or work-cvar (goal-frame and goal-frame-any semantics: log of the tuned RRT's median work / work per problem, half its mean plus half the mean of the worst quarter of problems)."),
+    fitness: str = typer.Option("paper", "--fitness", help="paper (mean of 10000 - iterations, -100 on failure), log-ratio (mean log of RRT's median / iterations per problem) or work-cvar (goal-frame and goal-frame-any semantics: log of the tuned RRT's median work / work per problem, half its mean plus half the mean of the worst quarter of problems) or work-cost-cvar (goal-frame: work-cvar minus --cost-weight times the mean log of the path cost / the tuned RRT's median path cost per problem)."),
+    cost_weight: float = typer.Option(1.0, "--cost-weight", help="work-cost-cvar: weight of the path-cost term (1: one per cent of path length weighs as much as one per cent of work)."),
     validation_scenario: List[Path] = typer.Option([], "--validation-scenario", help="Held-out scenario file or directory (repeatable): picks the final rulebook, gives the train/validation gap."),
     max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run (reward = max_iter - iterations)."),
     elite: int = typer.Option(8, "--elite", help="Best individuals copied unchanged into the next generation."),
@@ -105,7 +106,7 @@ def train(
 
     if workers is not None and workers < 1:
         raise InputError("--workers", f"must be >= 1, got {workers}")
-    from xfuzzy_rrt.training.run import baselines
+    from xfuzzy_rrt.training.run import baselines, cost_baselines
 
     scenarios = load_training_scenarios(scenario)
     held_out = load_training_scenarios(validation_scenario) if validation_scenario else []
@@ -120,14 +121,21 @@ def train(
                     for t in held_out]
     if target_fitness is None:
         target_fitness = 9750.0 if fitness == "paper" else 1e9
-    base = v_base = ()
+    base = v_base = cost = v_cost = ()
     check_fitness_fits(fitness, bounds)  # before the baselines: a mismatch is one line at once
-    if fitness in ("log-ratio", "work-cvar"):
-        what = "RRT's median iterations" if fitness == "log-ratio" else "the tuned RRT's median work"
+    if not cost_weight >= 0 or cost_weight == float("inf"):
+        raise InputError("--cost-weight", f"must be a finite number >= 0, got {cost_weight}")
+    if fitness in ("log-ratio", "work-cvar", "work-cost-cvar"):
+        what = {"log-ratio": "RRT's median iterations",
+                "work-cost-cvar": "the tuned RRT's median work and path cost"}.get(
+                    fitness, "the tuned RRT's median work")
         typer.echo(f"computing {what} on {len(scenarios) + len(held_out)} "
                    f"scenario(s) (the {fitness} baseline)", err=True)
         base = baselines(scenarios, max_iter, fitness)
         v_base = baselines(held_out, max_iter, fitness) if held_out else ()
+    if fitness == "work-cost-cvar":
+        cost = cost_baselines(scenarios, max_iter)
+        v_cost = cost_baselines(held_out, max_iter) if held_out else ()
     config = GAConfig(
         population=population, generations=generations, runs_per_eval=runs_per_eval,
         target_fitness=target_fitness, seed=seed, bounds=bounds, max_iter=max_iter, elite=elite,
@@ -137,7 +145,8 @@ def train(
         scenarios=tuple((t.scenario.name, t.sha256) for t in scenarios),
         fitness=fitness, baseline=base,
         validation=tuple((t.scenario.name, t.sha256) for t in held_out), validation_baseline=v_base,
-        clearance_m=clearance, dof=dof,
+        clearance_m=clearance, dof=dof, baseline_cost=cost, validation_baseline_cost=v_cost,
+        cost_weight=cost_weight,
     )
     seeds = resolve_seed_rulebooks(seed_rulebook, config.init, config.bounds, config.dof)
     config = dataclasses.replace(config, seed_rulebooks=tuple((s.rulebook.name, s.sha256)

@@ -106,11 +106,13 @@ class Semantics:
     #: The fitness evaluation of a population in training: ``fn(problem, tree, knots_b,
     #: consts_b, mode, seeds, max_iter) -> int64[P, R]`` iterations (``-1``: failed); one that
     #: also counts work (``"work"`` in :attr:`measures`) takes an eighth argument,
-    #: ``measure="work"``, and then returns int64[P, R, 2] (iterations, work).
+    #: ``measure="work"``, and then returns int64[P, R, 2] (iterations, work); with
+    #: ``measure="cost"`` int64[P, R, 3] (iterations, work, path cost).
     population: object = None
     #: What :attr:`population` can report per run: iterations always; ``"work"`` only when it
     #: runs the planner's own kernel (a remembering evaluation does not spend the planner's
-    #: work), which ``train --fitness work-cvar`` needs.
+    #: work), which ``train --fitness work-cvar`` needs; ``"cost"`` (work and the found path's
+    #: cost) for ``--fitness work-cost-cvar``.
     measures: tuple[str, ...] = ("iterations",)
     #: One fuzzy evaluation per arm (the paper's workspace inputs are one arm's: its DOF is
     #: each arm's, and trace columns are prefixed ``arm<a>_``), else one for all arms (the
@@ -219,7 +221,7 @@ GOAL_FRAME = Semantics(
     modes=_ro({"goal-frame": 2}),  # planners/fuzzy_rrt.py's GOAL_FRAME
     kernel="xfuzzy_rrt.planners.fuzzy_rrt:goal_frame_entry",
     population="xfuzzy_rrt.training.evaluate:kernel_population",
-    measures=("iterations", "work"),
+    measures=("iterations", "work", "cost"),
     earlier_output_ranges=_ro({"step_deg": ((0.0, 120.0),)}),
 )
 

@@ -166,9 +166,19 @@ def finish_tree_run(nodes, parent, n, last, limits):
     ``limits`` (:func:`vertices_within`, the re-check :func:`certified_result` makes of a
     kernel's path). Why one call: six NumPy and two compiled calls cost a short plan more
     than its search (``benchmarks/overhead.py``)."""
-    dof = nodes.shape[1]
     tree_nodes = nodes[:n].copy()
     tree_parent = parent[:n].copy()
+    path = branch_path(nodes, parent, last)
+    within = path.shape[0] > 0 and vertices_within(path, limits)
+    return tree_nodes, tree_parent, path, path_cost_compiled(path), within
+
+
+@nb.njit(cache=True, nogil=True, _nrt=True)
+def branch_path(nodes, parent, last):
+    """The path from the root to node ``last`` of a tree (``nodes``/``parent``), root first;
+    empty when ``last < 0``. Shared by :func:`finish_tree_run` and the training evaluation
+    (:func:`branch_cost`), so a trained path's cost is the planner's to the bit."""
+    dof = nodes.shape[1]
     k = 0
     i = last
     while i >= 0:
@@ -182,8 +192,14 @@ def finish_tree_run(nodes, parent, n, last, limits):
             path[j, d] = nodes[i, d]
         j -= 1
         i = parent[i]
-    within = k > 0 and vertices_within(path, limits)
-    return tree_nodes, tree_parent, path, path_cost_compiled(path), within
+    return path
+
+
+@nb.njit(cache=True, nogil=True, _nrt=True)
+def branch_cost(nodes, parent, last):
+    """``PlanResult.cost_deg`` of the path to node ``last`` (:func:`branch_path`,
+    :func:`path_cost_compiled`), the same float bit for bit."""
+    return path_cost_compiled(branch_path(nodes, parent, last))
 
 
 class _Pending:

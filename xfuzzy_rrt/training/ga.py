@@ -46,7 +46,7 @@ import numpy as np
 
 from xfuzzy_rrt.fuzzy import semantics as _sem
 from xfuzzy_rrt.fuzzy.variables import N_RULES
-from xfuzzy_rrt.training.evaluate import FITNESSES, iterations_of, score
+from xfuzzy_rrt.training.evaluate import DEFAULT_COST_WEIGHT, FITNESSES, iterations_of, score
 from xfuzzy_rrt.training.operators import polynomial_mutation, sbx, tournament
 from xfuzzy_rrt.training.genome import (
     GENES_PER_FIS,
@@ -85,7 +85,7 @@ class GAConfig:
     init: str = "seeded"
     validation_runs: int = 50
     scenarios: tuple[tuple[str, str], ...] = ()  # (name, sha256) of each training scenario
-    fitness: str = "paper"  # or "log-ratio", "work-cvar" (see .evaluate.score)
+    fitness: str = "paper"  # or "log-ratio", "work-cvar", "work-cost-cvar" (see .evaluate.score)
     # per training scenario: RRT's median iterations (log-ratio) or the tuned RRT's median work (work-cvar)
     baseline: tuple[float, ...] = ()
     validation: tuple[tuple[str, str], ...] = ()  # held-out scenarios that pick the final rulebook
@@ -100,6 +100,12 @@ class GAConfig:
     #: ``--dof``: joints of the rulebook trained (paper: per arm; goal-frame: of all arms
     #: together). It sizes the genome (:func:`~.genome.n_genes`).
     dof: int = _sem.DEFAULT_DOF
+    #: ``work-cost-cvar``: the tuned RRT's median path cost (degrees) per training and per
+    #: validation scenario, and ``--cost-weight``, the weight of the path-cost term
+    #: (:func:`~.evaluate.work_cost_cvar_fitness`).
+    baseline_cost: tuple[float, ...] = ()
+    validation_baseline_cost: tuple[float, ...] = ()
+    cost_weight: float = DEFAULT_COST_WEIGHT
 
     @property
     def n_genes(self) -> int:
@@ -120,12 +126,24 @@ class GAConfig:
         need(0 <= self.seed < 2**63, "--seed", f"must lie in [0, 2^63), got {self.seed}")
         need(self.bounds in MODES, "--bounds", f"must be one of {', '.join(MODES)}, got {self.bounds!r}")
         need(self.fitness in FITNESSES, "--fitness", f"must be one of {', '.join(FITNESSES)}, got {self.fitness!r}")
-        if self.fitness in ("log-ratio", "work-cvar"):
+        if self.fitness in ("log-ratio", "work-cvar", "work-cost-cvar"):
             what = "RRT's median iterations" if self.fitness == "log-ratio" else "the tuned RRT's median work"
             need(len(self.baseline) == len(self.scenarios) and all(b > 0 for b in self.baseline),
                  "--fitness", f"{self.fitness} needs {what} (positive) for every training scenario")
             need(len(self.validation_baseline) == len(self.validation), "--validation-scenario",
                  f"{self.fitness} needs {what} for every validation scenario")
+        if self.fitness == "work-cost-cvar":
+            what = "the tuned RRT's median path cost"
+            need(len(self.baseline_cost) == len(self.scenarios)
+                 and all(np.isfinite(b) and b > 0 for b in self.baseline_cost),
+                 "--fitness", f"work-cost-cvar needs {what} (positive) for every training scenario")
+            need(len(self.validation_baseline_cost) == len(self.validation)
+                 and all(np.isfinite(b) and b > 0 for b in self.validation_baseline_cost),
+                 "--validation-scenario",
+                 f"work-cost-cvar needs {what} (positive) for every validation scenario")
+        need(isinstance(self.cost_weight, (int, float)) and np.isfinite(self.cost_weight)
+             and self.cost_weight >= 0, "--cost-weight",
+             f"must be a finite number >= 0, got {self.cost_weight!r}")
         check_fitness_fits(self.fitness, self.bounds)
         need(1 <= self.max_iter <= 1_000_000, "--max-iter", f"must lie in [1, 1000000], got {self.max_iter}")
         need(0 <= self.elite < self.population, "--elite", f"must lie in [0, population), got {self.elite}")
@@ -148,7 +166,9 @@ class GAConfig:
     #: Options added after the first checkpoints were written: left out of the fingerprint
     #: while they keep their default, so older checkpoints still resume.
     LATER = {"fitness": "paper", "baseline": (), "validation": (), "validation_baseline": (),
-             "seed_rulebooks": (), "clearance_m": None, "dof": _sem.DEFAULT_DOF}
+             "seed_rulebooks": (), "clearance_m": None, "dof": _sem.DEFAULT_DOF,
+             "baseline_cost": (), "validation_baseline_cost": (),
+             "cost_weight": DEFAULT_COST_WEIGHT}
 
     def fingerprint(self) -> str:
         """SHA-256 of the options that shape the search (identifies a checkpoint's run),
@@ -166,14 +186,22 @@ class GAConfig:
 
 def check_fitness_fits(fitness: str, bounds: str) -> None:
     """``--fitness work-cvar`` needs a semantics whose training evaluation counts the
-    planner's work (:attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.measures`): one line, which
-    ``train`` reports before it spends minutes on the baselines."""
-    if fitness == "work-cvar" and bounds in MODES and "work" not in _sem.of_mode(bounds).measures:
-        from xfuzzy_rrt.errors import InputError
+    planner's work (:attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.measures`), ``work-cost-cvar``
+    one that also measures path cost: one line, which ``train`` reports before it spends
+    minutes on the baselines."""
+    if bounds not in MODES:
+        return
+    measures = _sem.of_mode(bounds).measures
+    from xfuzzy_rrt.errors import InputError
 
-        raise InputError("--fitness", "work-cvar counts the planner's work, which only the "
+    if fitness in ("work-cvar", "work-cost-cvar") and "work" not in measures:
+        raise InputError("--fitness", f"{fitness} counts the planner's work, which only the "
                          "planner's own kernel spends: train it with --bounds goal-frame, not "
                          f"{bounds}")
+    if fitness == "work-cost-cvar" and "cost" not in measures:
+        raise InputError("--fitness", "work-cost-cvar measures path cost, which only the "
+                         "single-tree goal-frame evaluation reports: train it with --bounds "
+                         f"goal-frame, not {bounds}")
 
 
 def generation_seeds(seed: int, generation: int, runs: int) -> np.ndarray:
@@ -369,7 +397,9 @@ class Trainer:
     def _fitness(self, runs: np.ndarray, held_out: bool = False) -> np.ndarray:
         c = self.config
         baseline = c.validation_baseline if held_out else c.baseline
-        return score(runs, c.fitness, c.max_iter, np.asarray(baseline, dtype=np.float64))
+        cost = c.validation_baseline_cost if held_out else c.baseline_cost
+        return score(runs, c.fitness, c.max_iter, np.asarray(baseline, dtype=np.float64),
+                     np.asarray(cost, dtype=np.float64), c.cost_weight)
 
     def step(self, state: TrainState) -> TrainState:
         """Evaluate ``state.population``, record, stop or breed; return the next state."""

@@ -255,7 +255,8 @@ def canonical_command(config: GAConfig, scenario_args: list[str], out: str,
                ("mutation_rate", "--mutation-rate"), ("mutation_eta", "--mutation-eta"),
                ("block_rate", "--block-rate"), ("block_sigma", "--block-sigma"),
                ("init", "--init"), ("validation_runs", "--validation-runs"),
-               ("fitness", "--fitness"), ("clearance_m", "--clearance"), ("dof", "--dof")]
+               ("fitness", "--fitness"), ("cost_weight", "--cost-weight"),
+               ("clearance_m", "--clearance"), ("dof", "--dof")]
     always = {"population", "generations", "runs_per_eval", "target_fitness", "seed", "bounds"}
     for attr, flag in options:
         value = getattr(config, attr)
@@ -276,8 +277,27 @@ def baselines(scenarios: list[TrainingScenario], max_iter: int,
     from xfuzzy_rrt.training.evaluate import TrainingProblem, rrt_baseline, tuned_rrt_baseline
 
     problems = [TrainingProblem.from_scenario(t.scenario) for t in scenarios]
-    reference = tuned_rrt_baseline if fitness == "work-cvar" else rrt_baseline
+    reference = rrt_baseline if fitness == "log-ratio" else tuned_rrt_baseline
     return tuple(float(b) for b in reference(problems, np.arange(BASELINE_RUNS), max_iter))
+
+
+def cost_baselines(scenarios: list[TrainingScenario], max_iter: int) -> tuple[float, ...]:
+    """The tuned RRT's median path cost (degrees) on each scenario over seeds
+    ``0..BASELINE_RUNS-1`` (``work-cost-cvar``'s reference); a scenario on which it found no
+    path is one line naming it (no reference to measure lengths against)."""
+    import numpy as np
+
+    from xfuzzy_rrt.errors import InputError
+    from xfuzzy_rrt.training.evaluate import TrainingProblem, tuned_rrt_cost_baseline
+
+    problems = [TrainingProblem.from_scenario(t.scenario) for t in scenarios]
+    costs = tuned_rrt_cost_baseline(problems, np.arange(BASELINE_RUNS), max_iter)
+    for t, c in zip(scenarios, costs):
+        if not (np.isfinite(c) and c > 0):
+            raise InputError(t.path, f"the tuned RRT found no path in {BASELINE_RUNS} runs of "
+                             f"{max_iter} iterations, so work-cost-cvar has no path cost to "
+                             "compare with: leave this scenario out or raise --max-iter")
+    return tuple(float(c) for c in costs)
 
 
 def history_frame(history: list[dict]):
@@ -453,7 +473,7 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
         provenance["baseline"] = ("RRT median iterations per training scenario (seeds 0.."
                                   f"{BASELINE_RUNS - 1}, step 10 deg, goal bias 0.05)")
         provenance["baseline_iterations"] = [float(b) for b in c.baseline]
-    if c.fitness == "work-cvar":
+    if c.fitness in ("work-cvar", "work-cost-cvar"):
         from xfuzzy_rrt.planners.tuned import tuned_params
 
         tuned = tuned_params("rrt") or {}
@@ -461,14 +481,20 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
                                   f"deg, goal bias {tuned.get('goal_bias')}) median work per "
                                   f"training scenario (seeds 0..{BASELINE_RUNS - 1})")
         provenance["baseline_work"] = [float(b) for b in c.baseline]
+    if c.fitness == "work-cost-cvar":
+        provenance["cost_weight"] = c.cost_weight
+        provenance["baseline_cost_deg"] = [float(b) for b in c.baseline_cost]
     if job.validation:
         provenance["validation_fitness_history"] = [float(r["validation_fitness"]) for r in history]
         provenance["validation_scenarios"] = [
             {"name": t.scenario.name, "file": t.path, "sha256": t.sha256} for t in job.validation]
         if c.fitness == "log-ratio":
             provenance["validation_baseline_iterations"] = [float(b) for b in c.validation_baseline]
-        if c.fitness == "work-cvar":
+        if c.fitness in ("work-cvar", "work-cost-cvar"):
             provenance["validation_baseline_work"] = [float(b) for b in c.validation_baseline]
+        if c.fitness == "work-cost-cvar":
+            provenance["validation_baseline_cost_deg"] = [float(b) for b in
+                                                          c.validation_baseline_cost]
     bounds_mode = c.bounds if c.bounds in BOUNDS_MODES else None  # only the paper's has one
     what = f"{c.bounds} bounds" if bounds_mode else f"{sem.name} semantics"
     description = (f"Trained by the genetic algorithm ({what}, {c.fitness} fitness) on "

@@ -24,7 +24,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from xfuzzy_rrt.errors import InputError
-from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for
+from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for, measure_shape
 from xfuzzy_rrt.training.genome import decode
 
 #: Chunks per worker per generation: enough to balance uneven runs, few enough to be cheap.
@@ -46,7 +46,8 @@ def evaluate_chunk(genes: np.ndarray, problems: Sequence[TrainingProblem], bound
                    measure: str = "iterations") -> np.ndarray:
     """Iterations int64[n, S, R] of the individuals ``genes`` [n, n_genes] (3,822 at 2 DOF;
     *dof* fixes the genome's outputs and ranges, see :func:`~.genome.decode`), or with
-    ``measure="work"`` int64[n, S, R, 2] (iterations and work, :func:`~.evaluate.iterations_for`)."""
+    ``measure="work"`` int64[n, S, R, 2] (iterations and work), ``"cost"`` int64[n, S, R, 3]
+    (and path cost; :func:`~.evaluate.iterations_for`)."""
     knots, consts = decode(genes, bounds_mode, dof)
     return iterations_for(list(problems), knots, consts, bounds_mode, seeds, max_iter, measure)
 
@@ -114,9 +115,10 @@ class Evaluator:
         self.measure = measure  # what each run reports (evaluate.MEASURES)
 
     def _out(self, genes: np.ndarray, seeds: np.ndarray) -> np.ndarray:
-        """The result array one call fills: [n, S, R], or [n, S, R, 2] for work."""
+        """The result array one call fills: [n, S, R], [n, S, R, 2] for work, [n, S, R, 3]
+        for cost (:func:`~.evaluate.measure_shape`)."""
         shape = (genes.shape[0], len(self.problems), len(seeds))
-        return np.empty(shape + ((2,) if self.measure == "work" else ()), dtype=np.int64)
+        return np.empty(shape + measure_shape(self.measure), dtype=np.int64)
 
     description = "in-process"
 

@@ -28,6 +28,7 @@ from xfuzzy_rrt.geometry.scenario import load_scenario
 from xfuzzy_rrt.planners.fuzzy_rrt import plan_fuzzy_rrt
 from xfuzzy_rrt.planners.goal_frame import arm_lever
 from xfuzzy_rrt.planners.rrt import plan_rrt
+from xfuzzy_rrt.planners.tuned import tuned_params
 from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for, log_ratio_fitness
 from xfuzzy_rrt.training.genome import constant_outputs_genome, decode, encode
 
@@ -286,6 +287,21 @@ def test_protocol_ratios_follow_from_its_own_runs_table(tmp_path, run_cli):
     assert gf["median_ratio"] == pytest.approx(np.median(ratios))
     assert gf["geomean_ratio"] == pytest.approx(np.exp(np.mean(np.log(ratios))))
     assert gf["worst_ratio"] == pytest.approx(min(ratios))
+    # path length against the tuned peer (issue 25's cost aim), from the same runs
+    tuned = tuned_params("rrt")
+    longer = []
+    for file in SCENARIOS:
+        sc = load_scenario(file)
+        peer = np.median([plan_rrt(sc, seed=s, **tuned).cost_deg for s in range(6)])
+        ours = np.median([plan_fuzzy_rrt(sc, rulebook=tmp_path / "gf", seed=s).cost_deg
+                          for s in range(6)])
+        row = problems[(problems["scenario"] == sc.name) & (problems["planner"] == "fuzzy-rrt:gf")]
+        assert row["cost_peer_ratio"].item() == pytest.approx(ours / peer)
+        longer.append(ours / peer)
+    assert gf["median_cost_peer_ratio"] == pytest.approx(np.median(longer))
+    assert gf["worst_cost_peer_ratio"] == pytest.approx(max(longer))
+    assert gf["problems_longer_than_peer"] == sum(x > 1 for x in longer)
+    assert "cost/peer" in proc.stdout
 
 
 def test_protocol_rejects_an_unknown_rulebook_with_one_line(run_cli):

@@ -127,11 +127,13 @@ def evaluate(
                f"against {_describe(base)}; iterations (the paper's measure) against RRT "
                f"(step 10 deg, goal bias 0.05). Times measured with {caches} caches "
                f"({_CACHES[caches]}). A failed run counts with the time, work and "
-               f"iterations ({max_iter}) it spent; cost ratio = planner / RRT (median over "
-               "successful runs)")
+               f"iterations ({max_iter}) it spent; cost = median path cost / RRT's, "
+               f"cost/{'peer' if base != 'rrt' else 'RRT'} = / {base}'s (< 1: shorter; medians "
+               "over successful runs)")
     header = ["rank", "planner", "time", "worst", "lost", "e2e work", "worst", "lost",
               "iterations", "geomean", "worst", "best", "lost", "success(min)", "success<RRT",
-              "cost", "median time", "median e2e work"]
+              "cost", f"cost/{'peer' if base != 'rrt' else 'RRT'}", "median time",
+              "median e2e work"]
     rows = []
     for r in result.summary.sort_values("time_rank", kind="stable").itertuples():
         rows.append([str(r.time_rank), r.planner, _fmt(r.median_time_total_ratio, "x"),
@@ -141,7 +143,8 @@ def evaluate(
                      _fmt(r.median_ratio, "x"), _fmt(r.geomean_ratio, "x"),
                      _fmt(r.worst_ratio, "x"), _fmt(r.best_ratio, "x"), str(r.problems_lost),
                      f"{100 * r.worst_success_rate:.0f} %", str(r.problems_success_below_rrt),
-                     _fmt(r.median_cost_ratio), _fmt(1000 * r.median_time_total_s, " ms"),
+                     _fmt(r.median_cost_ratio), _fmt(r.median_cost_peer_ratio),
+                     _fmt(1000 * r.median_time_total_s, " ms"),
                      "-" if r.median_work_total != r.median_work_total
                      else f"{r.median_work_total:.0f}"])
     widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]

@@ -84,3 +84,38 @@ def test_the_protocol_calls_planners_in_the_shuffled_order(monkeypatch):
     names = ["rrt", "rrt:tuned", "fuzzy-rrt"]
     assert [timed[3 * k:3 * k + 3] for k in range(6)] == \
         [[names[i] for i in protocol.call_order(3, k)] for k in range(6)]
+
+
+def test_a_rulebook_planner_compared_as_a_peer_gets_its_rulebook_loaded_once(monkeypatch):
+    # evaluate --peer fuzzy-rrt-connect used to pass no rulebook, so every timed call resolved
+    # the shipped folder again (a stat; ~100 us of a 3-joint call with cold caches) while the
+    # default it was compared with had its rulebooks preloaded
+    from xfuzzy_rrt.fuzzy import rulebook as rb_module
+    from xfuzzy_rrt.fuzzy.rulebook import Rulebook
+
+    scenario = load_scenario(DEMO)
+    alone = plan_scenario(scenario, "fuzzy-rrt-connect", seed=3, max_iter=500)
+    resolved = []
+    real = rb_module.load_rulebook_cached
+    monkeypatch.setattr(rb_module, "load_rulebook_cached",
+                        lambda *a, **k: resolved.append(a) or real(*a, **k))
+    given = api.preloaded("fuzzy-rrt-connect", None)
+    assert isinstance(given, Rulebook) and given.name == "goal-frame-any"
+    result = run_protocol([scenario], [("fuzzy-rrt-connect", "fuzzy-rrt-connect", None)],
+                          runs=3, max_iter=500)
+    assert resolved == []  # no run resolved a rulebook folder
+    runs = result.runs[result.runs["planner"] == "fuzzy-rrt-connect"]
+    assert len(runs) == 3 and set(runs["rulebook"]) == {"goal-frame-any"}
+    same = plan_scenario(scenario, "fuzzy-rrt-connect", rulebook=given, seed=3, max_iter=500)
+    assert same.work == alone.work and (same.path_deg == alone.path_deg).all()
+
+
+def test_a_label_naming_its_rulebook_gets_that_folder_loaded_once():
+    from xfuzzy_rrt.fuzzy.rulebook import Rulebook
+
+    for label, name in (("fuzzy-rrt:goal-frame", "goal-frame"),
+                        ("fuzzy-rrt-connect:goal-frame-any", "goal-frame-any")):
+        got = api.preloaded(label, None)
+        assert isinstance(got, Rulebook) and got.name == name
+    assert api.preloaded("rrt", None) is None
+    assert api.preloaded("fuzzy-rrt", None) is None  # plain: the caller loads the default

@@ -137,11 +137,17 @@ def load_tuned_rrt(where: str = "--planner") -> TunedRRT:
 
 def preloaded(planner: str, rulebook: Any) -> Any:
     """What a caller that plans ``planner`` many times passes as ``rulebook``: ``rrt:tuned``'s
-    settings read once (:class:`TunedRRT`) or an ``ompl:NAME`` label's tuned range read once
-    (:class:`~xfuzzy_rrt.planners.ompl_bridge.TunedRange`) when it passes nothing, else
-    ``rulebook`` as given
-    (the shipped default of plain ``fuzzy-rrt`` is loaded by its callers:
-    :func:`load_shipped_default`)."""
+    settings read once (:class:`TunedRRT`), an ``ompl:NAME`` label's tuned range read once
+    (:class:`~xfuzzy_rrt.planners.ompl_bridge.TunedRange`), or the rulebook of a label that
+    takes one, loaded once (``fuzzy-rrt-connect``: its shipped default; ``fuzzy-rrt:NAME``,
+    ``fuzzy-rrt-connect:DIR``: the folder the label names) when it passes nothing, else
+    ``rulebook`` as given (the shipped default of plain ``fuzzy-rrt`` is loaded by its callers:
+    :func:`load_shipped_default`).
+
+    Why every kind: a call given no rulebook resolves it again (the folder is stat-ed to notice
+    an edit), ~2 us warm and ~100 us of a 3-joint call that starts with cold caches; a planner
+    compared as a peer (``evaluate --peer fuzzy-rrt-connect``) paid that in every timed call
+    while the planners it was compared with did not."""
     if planner == RRT_TUNED and rulebook is None:
         return load_tuned_rrt()
     if rulebook is None and planner.startswith("ompl:"):
@@ -150,6 +156,13 @@ def preloaded(planner: str, rulebook: Any) -> Any:
         spec = parse_ompl_label(planner, "--planner")
         if spec.range_deg is None:  # the label's own range needs nothing read
             return load_tuned_range(spec.base)
+    if rulebook is None and planner != "fuzzy-rrt":
+        spec = parse_planner(planner, "--planner")
+        if spec.planner.takes_rulebook:
+            from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
+
+            return load_rulebook(spec.rulebook_dir if spec.rulebook_dir is not None
+                                 else default_rulebook_dir(spec.kind))
     return rulebook
 
 

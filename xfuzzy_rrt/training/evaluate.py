@@ -288,6 +288,7 @@ def measure_shape(measure: str) -> tuple[int, ...]:
     (iterations, work) or ``(3,)`` (iterations, work, cost)."""
     return {"iterations": (), "work": (2,), "cost": (3,)}[measure]
 
+
 #: Share of the problems ``work-cvar`` averages as its worst case (the CVaR level).
 CVAR_SHARE = 0.25
 

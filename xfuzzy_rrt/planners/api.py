@@ -83,7 +83,8 @@ def shipped_default(scenario: Scenario) -> tuple[str, Path]:
     other problem (one arm of 3-7 joints, or 2-4 arms) -> ``fuzzy-rrt-connect`` with the
     DOF-free ``goal-frame-any``. Why per problem (the fair protocol, end-to-end time against
     ``rrt:tuned``, medians over 48 unseen problems per family; README): at 2 joints goal-frame
-    Fuzzy-RRT is the faster of the two (1.01-1.24x against Connect's 0.61-0.73x); beyond two it
+    Fuzzy-RRT is the faster of the two (warm, nineteenth session: 1.00-1.07x against Connect's
+    0.80-0.94x with its rulebook loaded once; docs/peer-measurements.md); beyond two it
     does not fit at all, and Connect with ``goal-frame-any`` beats the per-DOF rulebooks there
     (5 joints 1.33x and 100 % certified success against ``goal-frame-5dof``'s 0.91x and 64 %;
     two 3-joint arms 2.09x against ``goal-frame-dual3``'s 1.25x).

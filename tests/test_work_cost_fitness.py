@@ -193,3 +193,19 @@ def test_a_non_default_cost_weight_is_in_the_recorded_command(tmp_path):
     manifest = (out / "rulebook.toml").read_text()
     assert "--fitness work-cost-cvar --cost-weight 2.5" in manifest
     assert "cost_weight = 2.5" in manifest and "baseline_cost_deg" in manifest
+
+
+def test_a_cost_weight_without_the_cost_fitness_is_refused_before_any_baseline(tmp_path):
+    out = tmp_path / "rb"
+    proc = run_main("train", "--scenario", SCENARIOS[0], "--bounds", "goal-frame",
+                    "--fitness", "work-cvar", "--cost-weight", "2", "--generations", "1",
+                    "--out", out)
+    errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("error")]
+    assert proc.returncode == 2 and not out.exists(), proc.stderr
+    assert errors == ["error: --cost-weight: weighs path cost in --fitness work-cost-cvar only, "
+                      "not in work-cvar"]
+    assert "computing" not in proc.stderr  # refused before the tuned RRT's baselines
+    with pytest.raises(InputError, match="work-cost-cvar only") as err:
+        GAConfig(bounds="goal-frame", fitness="work-cvar", scenarios=(("a", "0"),),
+                 baseline=(100.0,), cost_weight=2.0)
+    assert err.value.where == "--cost-weight"

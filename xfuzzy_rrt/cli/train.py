@@ -125,6 +125,9 @@ def train(
     check_fitness_fits(fitness, bounds)  # before the baselines: a mismatch is one line at once
     if not cost_weight >= 0 or cost_weight == float("inf"):
         raise InputError("--cost-weight", f"must be a finite number >= 0, got {cost_weight}")
+    if cost_weight != 1.0 and fitness != "work-cost-cvar":
+        raise InputError("--cost-weight", f"weighs path cost in --fitness work-cost-cvar only, "
+                         f"not in {fitness}")
     if fitness in ("log-ratio", "work-cvar", "work-cost-cvar"):
         what = {"log-ratio": "RRT's median iterations",
                 "work-cost-cvar": "the tuned RRT's median work and path cost"}.get(

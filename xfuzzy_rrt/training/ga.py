@@ -144,6 +144,9 @@ class GAConfig:
         need(isinstance(self.cost_weight, (int, float)) and np.isfinite(self.cost_weight)
              and self.cost_weight >= 0, "--cost-weight",
              f"must be a finite number >= 0, got {self.cost_weight!r}")
+        need(self.fitness == "work-cost-cvar" or self.cost_weight == DEFAULT_COST_WEIGHT,
+             "--cost-weight", f"weighs path cost in --fitness work-cost-cvar only, not in "
+                              f"{self.fitness}")
         check_fitness_fits(self.fitness, self.bounds)
         need(1 <= self.max_iter <= 1_000_000, "--max-iter", f"must lie in [1, 1000000], got {self.max_iter}")
         need(0 <= self.elite < self.population, "--elite", f"must lie in [0, population), got {self.elite}")

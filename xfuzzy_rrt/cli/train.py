@@ -72,7 +72,7 @@ def train(
     out: Path = typer.Option(..., "--out", help="Rulebook directory to write (also history.csv and checkpoint/)."),
     resume: bool = typer.Option(False, "--resume", help="Continue from OUT/checkpoint after an interruption."),
     bounds: str = typer.Option("absolute", "--bounds", help="Planner semantics: absolute or relative bounds (the paper's semantics), goal-frame, or goal-frame-any (one rulebook for any arm, trained with Fuzzy-RRT-Connect on scenarios of any DOF mixed)."),
-    fitness: str = typer.Option("paper", "--fitness", help="paper (mean of 10000 - iterations, -100 on failure), log-ratio (mean log of RRT's median / iterations per problem) or work-cvar (goal-frame and goal-frame-any semantics: log of the tuned RRT's median work / work per problem, half its mean plus half the mean of the worst quarter of problems) or work-cost-cvar (goal-frame: work-cvar minus --cost-weight times the mean log of the path cost / the tuned RRT's median path cost per problem)."),
+    fitness: str = typer.Option("paper", "--fitness", help="paper (mean of 10000 - iterations, -100 on failure), log-ratio (mean log of RRT's median / iterations per problem), work-cvar (goal-frame and goal-frame-any semantics: log of the tuned RRT's median work / work per problem, half its mean plus half the mean of the worst quarter of problems) or work-cost-cvar (goal-frame: work-cvar minus --cost-weight times the mean log of the path cost / the tuned RRT's median path cost per problem)."),
     cost_weight: float = typer.Option(1.0, "--cost-weight", help="work-cost-cvar: weight of the path-cost term (1: one per cent of path length weighs as much as one per cent of work)."),
     validation_scenario: List[Path] = typer.Option([], "--validation-scenario", help="Held-out scenario file or directory (repeatable): picks the final rulebook, gives the train/validation gap."),
     max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run (reward = max_iter - iterations)."),
@@ -125,7 +125,9 @@ def train(
     check_fitness_fits(fitness, bounds)  # before the baselines: a mismatch is one line at once
     if not cost_weight >= 0 or cost_weight == float("inf"):
         raise InputError("--cost-weight", f"must be a finite number >= 0, got {cost_weight}")
-    if cost_weight != 1.0 and fitness != "work-cost-cvar":
+    from xfuzzy_rrt.training.evaluate import DEFAULT_COST_WEIGHT
+
+    if cost_weight != DEFAULT_COST_WEIGHT and fitness != "work-cost-cvar":
         raise InputError("--cost-weight", f"weighs path cost in --fitness work-cost-cvar only, "
                          f"not in {fitness}")
     if fitness in ("log-ratio", "work-cvar", "work-cost-cvar"):

@@ -1,12 +1,14 @@
 """Our planners against the best *tuned* peer, problem by problem, from an ``evaluate`` folder.
 
-``xfuzzy-rrt evaluate`` ranks every planner against one baseline (``rrt:tuned``). A user does not
-care which peer is fastest on a problem, only how long the fastest one takes, so this takes per
-problem the smallest median end-to-end time (``time_total_s``; a failed run counts with the time
-it spent) of the peers ``rrt:tuned``, ``ompl:RRTConnect`` and ``ompl:BITstar`` that ran, and
-prints for each ``fuzzy-rrt*`` planner that best peer's median over its own: median, geometric
-mean and worst over problems, how many problems it loses, on how many its certified success is
-below some peer's, its median path cost over the tuned RRT's, and which peer was fastest where.
+``xfuzzy-rrt evaluate`` prints this itself since the nineteenth session (its second table and
+the ``*_best_peer_*`` columns of ``summary.csv``); this script recomputes it from a folder's
+``runs.csv`` -- older folders included -- with the same code (``bench/protocol.py``,
+``problem_table``): per problem the smallest median end-to-end time (``time_total_s``; a failed
+run counts with the time it spent) of the peers ``rrt:tuned``, ``ompl:RRTConnect`` and
+``ompl:BITstar`` that ran, and for each ``fuzzy-rrt*`` planner that best peer's median over its
+own: median, geometric mean and worst over problems, how many problems it loses, on how many
+its certified success is below some peer's, its median path cost over the tuned RRT's, and
+which peer was fastest where.
 
     python scripts/best_peer.py reports/eval/result-sample
 """
@@ -15,31 +17,26 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
 import pandas as pd
+
+from xfuzzy_rrt.bench.protocol import problem_table, summary_table
 
 PEERS = ("rrt:tuned", "ompl:RRTConnect", "ompl:BITstar")
 
 
 def main(folder: str) -> None:
     runs = pd.read_csv(f"{folder}/runs.csv")
-    peers = [p for p in PEERS if p in set(runs.planner)]
-    ours = [p for p in runs.planner.unique() if p.startswith("fuzzy-rrt")]
-    med = runs.groupby(["scenario", "planner"]).agg(
-        t=("time_total_s", "median"), s=("success", "mean"), c=("cost_deg", "median")).reset_index()
-    t = med.pivot(index="scenario", columns="planner", values="t")
-    s = med.pivot(index="scenario", columns="planner", values="s")
-    c = med.pivot(index="scenario", columns="planner", values="c")
-    best = t[peers].min(axis=1)
-    for p in ours:
-        r = best / t[p]
-        below = int((s[p] < s[peers].max(axis=1) - 1e-12).sum())
-        cost = float(np.nanmedian(c[p] / c["rrt:tuned"])) if "rrt:tuned" in c else float("nan")
-        print(f"{p:28s} vs best peer: median {np.median(r):.2f}x  geomean "
-              f"{np.exp(np.log(r).mean()):.2f}x  worst {r.min():.2f}x  lost {int((r < 1).sum())}/"
-              f"{len(r)}  success below a peer on {below}  cost/rrt:tuned {cost:.3f}  "
-              f"min success {s[p].min():.0%}")
-    print("fastest peer per problem:", t[peers].idxmin(axis=1).value_counts().to_dict())
+    order = list(dict.fromkeys(runs["planner"]))
+    peers = [p for p in PEERS if p in order]
+    summary = summary_table(problem_table(runs, order, peers)).set_index("planner")
+    for p in (p for p in order if p.startswith("fuzzy-rrt")):
+        r = summary.loc[p]
+        print(f"{p:28s} vs best peer: median {r.median_best_peer_ratio:.2f}x  geomean "
+              f"{r.geomean_best_peer_ratio:.2f}x  worst {r.worst_best_peer_ratio:.2f}x  lost "
+              f"{r.problems_lost_best_peer}/{r.problems}  success below a peer on "
+              f"{r.problems_success_below_peer}  cost/rrt:tuned {r.median_cost_peer_ratio:.3f}  "
+              f"min success {r.worst_success_rate:.0%}")
+    print("fastest peer per problem:", summary.iloc[0].best_peers)
 
 
 if __name__ == "__main__":

@@ -37,7 +37,16 @@ ran out (as its iterations count ``max_iter``): the user waited that long for no
 success rate beside it says how often. These ratios are taken against the *peer at its best*,
 the tuned RRT (``rrt:tuned``, shipped tuned file) when it runs -- by default it does -- else
 against RRT; the summary names that baseline (``time_work_baseline``) and ranks planners by
-their median end-to-end time ratio (``time_rank``, 1 = fastest). Path length is compared with
+their median end-to-end time ratio (``time_rank``, 1 = fastest).
+
+**Against the fastest tuned peer per problem** (issue 25's measure): a user does not care which
+peer is fastest on a problem, only how long the fastest one takes. Given the labels that are
+*peers* (``evaluate``: ``rrt:tuned`` and every ``--peer``; the paper's RRT never is one), each
+problem's ``best_peer`` is the peer with the smallest median end-to-end time, and
+``best_peer_ratio`` is that time over the planner's (> 1: faster than every peer);
+``success_below_peer`` says whether the planner's certified success rate is below some peer's.
+Per planner: median, geometric mean and worst (smallest) ratio, problems lost (ratio < 1),
+problems with success below a peer, and which peers were fastest where (``best_peers``). Path length is compared with
 the same peer too (``cost_peer_ratio`` = planner's median cost / the peer's, < 1: shorter;
 summarised as median, worst = largest, and how many problems are longer): issue 25's aim is a
 median path cost no higher than the tuned RRT's, and ``cost_ratio`` compares with the paper's
@@ -62,7 +71,8 @@ from xfuzzy_rrt.bench.caches import DEFAULT_CACHE_MODE, CacheEvictor, check_cach
 PROBLEM_COLUMNS = ["scenario", "planner", "runs", "success_rate", "median_iterations",
                    "median_cost_deg", "median_time_s", "iteration_ratio", "cost_ratio",
                    "time_ratio", "median_time_total_s", "median_work", "median_work_total",
-                   "time_total_ratio", "work_total_ratio", "cost_peer_ratio"]
+                   "time_total_ratio", "work_total_ratio", "cost_peer_ratio", "best_peer",
+                   "best_peer_ratio", "success_below_peer"]
 SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "worst_ratio",
                    "best_ratio", "problems_lost", "worst_success_rate",
                    "problems_success_below_rrt", "median_cost_ratio", "median_time_ratio",
@@ -70,7 +80,9 @@ SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "wors
                    "worst_time_total_ratio", "problems_lost_time", "median_work_total_ratio",
                    "worst_work_total_ratio", "problems_lost_work_total", "median_time_total_s",
                    "median_work", "median_work_total", "caches", "median_cost_peer_ratio",
-                   "worst_cost_peer_ratio", "problems_longer_than_peer"]
+                   "worst_cost_peer_ratio", "problems_longer_than_peer", "best_peers",
+                   "median_best_peer_ratio", "geomean_best_peer_ratio", "worst_best_peer_ratio",
+                   "problems_lost_best_peer", "problems_success_below_peer"]
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "cost_deg", "wall_s",
                "time_total_s", "work", "work_total", "planner_used", "rulebook",
                "rulebook_sha256"]
@@ -122,7 +134,7 @@ def block_order(n: int, i: int) -> list[int]:
 def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs: int = 50,
                  seed: int = 0, max_iter: int = 10_000, progress=None,
                  clearance_m: float | None = None,
-                 caches: str = DEFAULT_CACHE_MODE) -> ProtocolResult:
+                 caches: str = DEFAULT_CACHE_MODE, peers=None) -> ProtocolResult:
     """Run RRT and every ``(label, planner, rulebook)`` of *planners* on every scenario (put
     ``("rrt:tuned", "rrt:tuned", None)`` among them to rank against the tuned RRT).
 
@@ -131,6 +143,9 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     ``cold`` (evicted before every call), ``warm`` (each planner's seeds of a problem in a row,
     after an untimed call) or ``shuffled`` (planners shuffled per seed, nothing evicted). Only
     the timings depend on it.
+
+    ``peers``: the labels that count as tuned peers for the best-peer columns (default: every
+    label of *planners* that is not a Fuzzy-RRT one, i.e. ``rrt:tuned`` and ``ompl:...``).
 
     ``planner`` is a name :func:`~xfuzzy_rrt.planners.api.plan_scenario` takes (``fuzzy-rrt``
     with a loaded ``rulebook`` or the :class:`~xfuzzy_rrt.planners.api.ShippedDefault`, or
@@ -198,13 +213,16 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     frame = pd.DataFrame(rows, columns=RUN_COLUMNS)
     for col in ("work", "work_total"):
         frame[col] = frame[col].astype("Int64")
-    problems = problem_table(frame, [e[0] for e in entries])
+    if peers is None:
+        peers = [label for label, planner, _ in planners if not planner.startswith("fuzzy-rrt")]
+    problems = problem_table(frame, [e[0] for e in entries], peers)
     return ProtocolResult(runs=frame, problems=problems,
                           summary=summary_table(problems, caches=caches))
 
 
-def problem_table(runs: pd.DataFrame, order: list[str]) -> pd.DataFrame:
-    """Per (scenario, planner) medians and ratios to RRT (see the module docstring)."""
+def problem_table(runs: pd.DataFrame, order: list[str], peers=()) -> pd.DataFrame:
+    """Per (scenario, planner) medians and ratios to RRT, to the tuned peer and to the fastest
+    of the *peers* (labels; see the module docstring)."""
     runs = runs.copy()
     for col in ("time_total_s", "work", "work_total"):
         runs[col] = (pd.to_numeric(runs[col], errors="coerce").astype(float) if col in runs
@@ -232,10 +250,29 @@ def problem_table(runs: pd.DataFrame, order: list[str]) -> pd.DataFrame:
                                / per["median_work_total"])
     # path length against the same peer, planner / peer (< 1: shorter), like cost_ratio
     per["cost_peer_ratio"] = per["median_cost_deg"] / per["scenario"].map(peer["median_cost_deg"])
+    _best_peer_columns(per, peers)
     per["planner"] = pd.Categorical(per["planner"], categories=order, ordered=True)
     per = per.sort_values(["planner", "scenario"], kind="stable").reset_index(drop=True)
     per["planner"] = per["planner"].astype(str)
     return per[PROBLEM_COLUMNS]
+
+
+def _best_peer_columns(per: pd.DataFrame, peers) -> None:
+    """``best_peer``, ``best_peer_ratio`` and ``success_below_peer`` of each row of *per* (one
+    row per scenario and planner), in place; empty without peers among the planners that ran.
+    A failed run counts with the time it spent (as ``time_total_ratio``)."""
+    peers = [p for p in dict.fromkeys(peers) if p in set(per["planner"]) and p != BASELINE]
+    if not peers:
+        per["best_peer"], per["best_peer_ratio"], per["success_below_peer"] = None, np.nan, False
+        return
+    mine = per[per["planner"].isin(peers)]
+    times = mine.pivot(index="scenario", columns="planner", values="median_time_total_s")
+    success = mine.pivot(index="scenario", columns="planner", values="success_rate")
+    fastest = times.idxmin(axis=1)
+    per["best_peer"] = per["scenario"].map(fastest)
+    per["best_peer_ratio"] = per["scenario"].map(times.min(axis=1)) / per["median_time_total_s"]
+    per["success_below_peer"] = (per["success_rate"]
+                                 < per["scenario"].map(success.max(axis=1)) - 1e-12)
 
 
 def time_work_baseline(planners) -> str:
@@ -254,7 +291,8 @@ def _dist(values) -> tuple[float, float, int]:
 
 def summary_table(problems: pd.DataFrame, caches: str = "") -> pd.DataFrame:
     """One row per planner (RRT included, whose ratios are 1 by construction); ``caches``
-    names the cache mode the times were measured in (:mod:`xfuzzy_rrt.bench.caches`)."""
+    names the cache mode the times were measured in (:mod:`xfuzzy_rrt.bench.caches`).
+    The best-peer columns summarise ``best_peer_ratio`` (:func:`_best_peer_columns`)."""
     rows = []
     peer = time_work_baseline(problems["planner"])
     rrt_success = problems[problems["planner"] == "rrt"].set_index("scenario")["success_rate"]
@@ -293,6 +331,17 @@ def summary_table(problems: pd.DataFrame, caches: str = "") -> pd.DataFrame:
             "median_cost_peer_ratio": float(np.median(c)) if c.size else np.nan,
             "worst_cost_peer_ratio": float(c.max()) if c.size else np.nan,
             "problems_longer_than_peer": int((c > 1.0).sum()),
+        })
+        b = g["best_peer_ratio"].to_numpy(dtype=float)
+        b = b[np.isfinite(b) & (b > 0)]
+        rows[-1].update({
+            "best_peers": ", ".join(f"{k} {v}" for k, v in
+                                    g["best_peer"].dropna().value_counts().items()),
+            "median_best_peer_ratio": float(np.median(b)) if b.size else np.nan,
+            "geomean_best_peer_ratio": float(np.exp(np.log(b).mean())) if b.size else np.nan,
+            "worst_best_peer_ratio": float(b.min()) if b.size else np.nan,
+            "problems_lost_best_peer": int((b < 1.0).sum()),
+            "problems_success_below_peer": int(g["success_below_peer"].astype(bool).sum()),
         })
     frame = pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
     # Rank on end-to-end time (1 = the largest median ratio to the baseline); ties share.

@@ -113,8 +113,9 @@ def evaluate(
             sys.stderr.write(f"\r  {done}/{total} (problem, planner) pairs")
             sys.stderr.flush()
 
+    peers = [e[0] for e in entries if e[0] == "rrt:tuned" or e[1] in peer]
     result = run_protocol(scenarios, entries, runs=runs, seed=seed, max_iter=max_iter,
-                          progress=progress, clearance_m=clearance, caches=caches)
+                          progress=progress, clearance_m=clearance, caches=caches, peers=peers)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     if out is not None:
@@ -147,12 +148,26 @@ def evaluate(
                      _fmt(1000 * r.median_time_total_s, " ms"),
                      "-" if r.median_work_total != r.median_work_total
                      else f"{r.median_work_total:.0f}"])
-    widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
-    for line in [header, *rows]:
-        typer.echo("  ".join(str(x).ljust(w) for x, w in zip(line, widths)).rstrip())
+    _table(header, rows)
+    ours = result.summary[~result.summary["planner"].isin([*peers, "rrt"])]
+    if peers and len(ours):
+        typer.echo(f"Against the fastest of {', '.join(peers)} on each problem (its median "
+                   "end-to-end time / the planner's; success below: problems where some peer's "
+                   "certified success is higher):")
+        _table(["planner", "median", "geomean", "worst", "lost", "success below", "fastest peer"],
+               [[r.planner, _fmt(r.median_best_peer_ratio, "x"),
+                 _fmt(r.geomean_best_peer_ratio, "x"), _fmt(r.worst_best_peer_ratio, "x"),
+                 f"{r.problems_lost_best_peer}/{r.problems}", str(r.problems_success_below_peer),
+                 r.best_peers] for r in ours.itertuples()])
     if out is not None:
         typer.echo(f"wrote {out}/runs.csv, problems.csv, summary.csv")
     return 0
+
+
+def _table(header: list[str], rows: list[list[str]]) -> None:
+    widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
+    for line in [header, *rows]:
+        typer.echo("  ".join(str(x).ljust(w) for x, w in zip(line, widths)).rstrip())
 
 
 _CACHES = {"cold": "evicted before every timed call",

@@ -209,3 +209,28 @@ def test_a_cost_weight_without_the_cost_fitness_is_refused_before_any_baseline(t
         GAConfig(bounds="goal-frame", fitness="work-cvar", scenarios=(("a", "0"),),
                  baseline=(100.0,), cost_weight=2.0)
     assert err.value.where == "--cost-weight"
+
+
+def test_work_cost_cvar_runs_the_tuned_rrt_once_per_scenario_for_both_baselines(tmp_path,
+                                                                                  monkeypatch):
+    from xfuzzy_rrt.training import evaluate
+
+    calls = []
+    real = evaluate.rrt_runs
+    monkeypatch.setattr(evaluate, "rrt_runs", lambda pr, *a: calls.append(pr.name) or real(pr, *a))
+    out = tmp_path / "rb"
+    proc = run_main("train", "--scenario", SCENARIOS[0], "--validation-scenario", SCENARIOS[1],
+                    "--bounds", "goal-frame", "--fitness", "work-cost-cvar", "--population", "6",
+                    "--elite", "1", "--generations", "1", "--runs-per-eval", "1",
+                    "--validation-runs", "1", "--workers", "1", "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(calls) == sorted(load_scenario(p).name for p in SCENARIOS)
+
+
+def test_a_misspelt_fitness_is_named_before_the_cost_weight(tmp_path):
+    out = tmp_path / "rb"
+    proc = run_main("train", "--scenario", SCENARIOS[0], "--bounds", "goal-frame",
+                    "--fitness", "work-cost-cvr", "--cost-weight", "2", "--out", out)
+    errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("error")]
+    assert proc.returncode == 2 and not out.exists(), proc.stderr
+    assert len(errors) == 1 and errors[0].startswith("error: --fitness: must be one of")

@@ -106,7 +106,7 @@ def train(
 
     if workers is not None and workers < 1:
         raise InputError("--workers", f"must be >= 1, got {workers}")
-    from xfuzzy_rrt.training.run import baselines, cost_baselines
+    from xfuzzy_rrt.training.run import baselines, work_and_cost_baselines
 
     scenarios = load_training_scenarios(scenario)
     held_out = load_training_scenarios(validation_scenario) if validation_scenario else []
@@ -125,8 +125,10 @@ def train(
     check_fitness_fits(fitness, bounds)  # before the baselines: a mismatch is one line at once
     if not cost_weight >= 0 or cost_weight == float("inf"):
         raise InputError("--cost-weight", f"must be a finite number >= 0, got {cost_weight}")
-    from xfuzzy_rrt.training.evaluate import DEFAULT_COST_WEIGHT
+    from xfuzzy_rrt.training.evaluate import DEFAULT_COST_WEIGHT, FITNESSES
 
+    if fitness not in FITNESSES:  # before what depends on it (GAConfig says it again)
+        raise InputError("--fitness", f"must be one of {', '.join(FITNESSES)}, got {fitness!r}")
     if cost_weight != DEFAULT_COST_WEIGHT and fitness != "work-cost-cvar":
         raise InputError("--cost-weight", f"weighs path cost in --fitness work-cost-cvar only, "
                          f"not in {fitness}")
@@ -136,11 +138,12 @@ def train(
                     fitness, "the tuned RRT's median work")
         typer.echo(f"computing {what} on {len(scenarios) + len(held_out)} "
                    f"scenario(s) (the {fitness} baseline)", err=True)
-        base = baselines(scenarios, max_iter, fitness)
-        v_base = baselines(held_out, max_iter, fitness) if held_out else ()
-    if fitness == "work-cost-cvar":
-        cost = cost_baselines(scenarios, max_iter)
-        v_cost = cost_baselines(held_out, max_iter) if held_out else ()
+        if fitness == "work-cost-cvar":  # one set of the tuned RRT's runs gives both
+            base, cost = work_and_cost_baselines(scenarios, max_iter)
+            v_base, v_cost = work_and_cost_baselines(held_out, max_iter) if held_out else ((), ())
+        else:
+            base = baselines(scenarios, max_iter, fitness)
+            v_base = baselines(held_out, max_iter, fitness) if held_out else ()
     config = GAConfig(
         population=population, generations=generations, runs_per_eval=runs_per_eval,
         target_fitness=target_fitness, seed=seed, bounds=bounds, max_iter=max_iter, elite=elite,

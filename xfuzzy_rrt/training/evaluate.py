@@ -39,14 +39,15 @@ FAILURE_REWARD = -100.0
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_step,
-                            stop):
+                            stop, with_cost):
     """Iterations, work and path cost of every (individual, seed) run: int64[P, R, 3].
 
     ``[..., 0]`` is the run's iterations, ``-1`` for a failed run; ``[..., 1]`` the work it
     spent, failed runs included: exact element distance evaluations (``P.work``) plus
     nearest-neighbour node visits, as ``PlanResult.work`` counts them (the deterministic count
     the fair protocol ranks planners on); ``[..., 2]`` the found path's ``PlanResult.cost_deg``
-    in units of :data:`COST_UNIT_DEG` (rounded; ``-1`` for a failed run).
+    in units of :data:`COST_UNIT_DEG` (rounded; ``-1`` for a failed run, and for every run
+    unless ``with_cost``: walking and copying the path is the only work a run does for it).
     ``knots_b`` [P, n_out, 4, 5] and ``consts_b`` [P, n_out, 625] are decoded individuals;
     ``T`` is one preallocated tree (:func:`~xfuzzy_rrt.planners.tree.make_tree`), emptied
     before each run. Nothing is traced: the kernels take ``None`` for their trace arrays.
@@ -77,7 +78,7 @@ def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_ite
             out[p, r, 0] = iterations if ok else -1
             out[p, r, 1] = P.work[0] - work0 + T.meta[NN_VISITS]
             out[p, r, 2] = -1
-            if ok:
+            if ok and with_cost:
                 out[p, r, 2] = np.int64(np.rint(branch_cost(T.nodes, T.parent, last)
                                                  / COST_UNIT_DEG))
     return out
@@ -88,7 +89,7 @@ def run_population(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter, min_st
     """Iterations of every (individual, seed) run: int64[P, R], ``-1`` for a failed run
     (:func:`run_population_measured` without the work and cost columns)."""
     return run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_iter,
-                                   min_step, stop)[:, :, 0].copy()
+                                   min_step, stop, False)[:, :, 0].copy()
 
 
 @dataclass(frozen=True)
@@ -186,7 +187,8 @@ def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, s
         # problem objects, and a shared counter would count the other thread's work too
         bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))
         out = run_population_measured(bundle, tree, knots_b, consts_b, mode, seeds,
-                                      int(max_iter), MIN_STEP_DEG, np.zeros(1, dtype=np.int64))
+                                      int(max_iter), MIN_STEP_DEG, np.zeros(1, dtype=np.int64),
+                                      measure == "cost")
         return out if measure == "cost" else out[:, :, :2].copy()
     return run_population(pr.bundle, tree, knots_b, consts_b, mode, seeds, int(max_iter),
                           MIN_STEP_DEG, np.zeros(1, dtype=np.int64))
@@ -382,7 +384,7 @@ def work_cost_cvar_fitness(runs: np.ndarray, baseline_work: np.ndarray,
 
     ``runs`` is int64[P, S, R, 3] (iterations, work, cost; :func:`run_population_measured`);
     ``baseline_cost[s]`` the tuned RRT's median path cost (degrees) on problem ``s``
-    (:func:`tuned_rrt_cost_baseline`). A problem on which no run succeeded adds nothing to
+    (:func:`tuned_rrt_baselines`). A problem on which no run succeeded adds nothing to
     the cost term: its failures already weigh at least ``log 20`` each in the work term.
 
     Why: trained on work alone, the 2-joint default learnt steps of ~230 deg and the tuned
@@ -481,10 +483,3 @@ def tuned_rrt_baselines(problems: list[TrainingProblem], seeds: np.ndarray, max_
         if found.size:
             cost[s] = float(np.median(found * COST_UNIT_DEG))
     return work, cost
-
-
-def tuned_rrt_cost_baseline(problems: list[TrainingProblem], seeds: np.ndarray,
-                            max_iter: int) -> np.ndarray:
-    """The tuned RRT's median path cost (degrees) per problem over *seeds* (NaN where it
-    found no path): the reference of ``work-cost-cvar``'s cost term."""
-    return tuned_rrt_baselines(problems, seeds, max_iter, "work-cost-cvar")[1]

@@ -281,23 +281,26 @@ def baselines(scenarios: list[TrainingScenario], max_iter: int,
     return tuple(float(b) for b in reference(problems, np.arange(BASELINE_RUNS), max_iter))
 
 
-def cost_baselines(scenarios: list[TrainingScenario], max_iter: int) -> tuple[float, ...]:
-    """The tuned RRT's median path cost (degrees) on each scenario over seeds
-    ``0..BASELINE_RUNS-1`` (``work-cost-cvar``'s reference); a scenario on which it found no
-    path is one line naming it (no reference to measure lengths against)."""
+def work_and_cost_baselines(scenarios: list[TrainingScenario], max_iter: int
+                            ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """``work-cost-cvar``'s references from one set of the tuned RRT's runs per scenario (seeds
+    ``0..BASELINE_RUNS-1``): its median work (as :func:`baselines` gives for ``work-cvar``)
+    and its median path cost in degrees. A scenario on which it found no path is one line
+    naming it (no reference to measure lengths against)."""
     import numpy as np
 
     from xfuzzy_rrt.errors import InputError
-    from xfuzzy_rrt.training.evaluate import TrainingProblem, tuned_rrt_cost_baseline
+    from xfuzzy_rrt.training.evaluate import TrainingProblem, tuned_rrt_baselines
 
     problems = [TrainingProblem.from_scenario(t.scenario) for t in scenarios]
-    costs = tuned_rrt_cost_baseline(problems, np.arange(BASELINE_RUNS), max_iter)
+    work, costs = tuned_rrt_baselines(problems, np.arange(BASELINE_RUNS), max_iter,
+                                      "work-cost-cvar")
     for t, c in zip(scenarios, costs):
         if not (np.isfinite(c) and c > 0):
             raise InputError(t.path, f"the tuned RRT found no path in {BASELINE_RUNS} runs of "
                              f"{max_iter} iterations, so work-cost-cvar has no path cost to "
                              "compare with: leave this scenario out or raise --max-iter")
-    return tuple(float(c) for c in costs)
+    return tuple(float(w) for w in work), tuple(float(c) for c in costs)
 
 
 def history_frame(history: list[dict]):

@@ -120,7 +120,7 @@ def load_rulebooks(planners: list[str], rulebook=None) -> tuple[dict[str, Any], 
     broken rulebook fails here, before any planning.
     """
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
-    from xfuzzy_rrt.planners.api import default_rulebook_dir, parse_planner
+    from xfuzzy_rrt.planners.api import label_rulebook_dir, parse_planner
 
     books: dict[str, Any] = {}
     dirs: dict[str, str] = {}
@@ -128,9 +128,9 @@ def load_rulebooks(planners: list[str], rulebook=None) -> tuple[dict[str, Any], 
         spec = parse_planner(label, "--planners")
         if not spec.planner.takes_rulebook:
             continue
-        source = spec.rulebook_dir if spec.rulebook_dir is not None else rulebook
-        if source is None:
-            source = default_rulebook_dir(spec.kind)
+        # the label's own folder first, then the caller's rulebook, then the shipped default
+        source = rulebook if spec.rulebook_dir is None and rulebook is not None \
+            else label_rulebook_dir(spec)
         if hasattr(source, "arrays"):
             books[label] = source
             dirs[label] = None

@@ -75,6 +75,13 @@ def default_rulebook_dir(kind: str) -> Path:
     return default_rulebook_path()
 
 
+def label_rulebook_dir(spec: "PlannerSpec") -> Path:
+    """The rulebook folder a rulebook label plans with when no rulebook is passed: the one the
+    label names (``fuzzy-rrt:NAME``, ``fuzzy-rrt-connect:DIR``), else its kind's shipped
+    default (:func:`default_rulebook_dir`)."""
+    return spec.rulebook_dir if spec.rulebook_dir is not None else default_rulebook_dir(spec.kind)
+
+
 def shipped_default(scenario: Scenario) -> tuple[str, Path]:
     """``(planner, rulebook directory)`` that plain ``fuzzy-rrt`` runs on *scenario* when the
     user names no rulebook (no ``--rulebook``, no ``fuzzy-rrt:NAME``, ``rulebook=None``).
@@ -162,8 +169,7 @@ def preloaded(planner: str, rulebook: Any) -> Any:
         if spec.planner.takes_rulebook:
             from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 
-            return load_rulebook(spec.rulebook_dir if spec.rulebook_dir is not None
-                                 else default_rulebook_dir(spec.kind))
+            return load_rulebook(label_rulebook_dir(spec))
     return rulebook
 
 

@@ -33,7 +33,8 @@ def main(folder: str) -> None:
         r = summary.loc[p]
         print(f"{p:28s} vs best peer: median {r.median_best_peer_ratio:.2f}x  geomean "
               f"{r.geomean_best_peer_ratio:.2f}x  worst {r.worst_best_peer_ratio:.2f}x  lost "
-              f"{r.problems_lost_best_peer}/{r.problems}  success below a peer on "
+              f"{r.problems_lost_best_peer}/{r.problems} (surely {r.problems_surely_lost_best_peer}; "
+              f"surely won {r.problems_surely_won_best_peer})  success below a peer on "
               f"{r.problems_success_below_peer}  cost/rrt:tuned {r.median_cost_peer_ratio:.3f}  "
               f"min success {r.worst_success_rate:.0%}")
     print("fastest peer per problem:", summary.iloc[0].best_peers)

@@ -46,7 +46,11 @@ problem's ``best_peer`` is the peer with the smallest median end-to-end time, an
 ``best_peer_ratio`` is that time over the planner's (> 1: faster than every peer);
 ``success_below_peer`` says whether the planner's certified success rate is below some peer's.
 Per planner: median, geometric mean and worst (smallest) ratio, problems lost (ratio < 1),
-problems with success below a peer, and which peers were fastest where (``best_peers``). Path length is compared with
+problems with success below a peer, and which peers were fastest where (``best_peers``). Each
+ratio comes with its 95 % bootstrap interval over the seeds (``best_peer_ratio_lo``/``_hi``,
+:mod:`xfuzzy_rrt.bench.interval`), and a problem counts as *surely* lost (won) only when the
+whole interval lies below (above) 1: with a few dozen seeds of runs lasting microseconds, a
+ratio of 0.8x can be a coin toss. Path length is compared with
 the same peer too (``cost_peer_ratio`` = planner's median cost / the peer's, < 1: shorter;
 summarised as median, worst = largest, and how many problems are longer): issue 25's aim is a
 median path cost no higher than the tuned RRT's, and ``cost_ratio`` compares with the paper's
@@ -67,12 +71,14 @@ import numpy as np
 import pandas as pd
 
 from xfuzzy_rrt.bench.caches import DEFAULT_CACHE_MODE, CacheEvictor, check_cache_mode
+from xfuzzy_rrt.bench.interval import median_ratio_interval
 
 PROBLEM_COLUMNS = ["scenario", "planner", "runs", "success_rate", "median_iterations",
                    "median_cost_deg", "median_time_s", "iteration_ratio", "cost_ratio",
                    "time_ratio", "median_time_total_s", "median_work", "median_work_total",
                    "time_total_ratio", "work_total_ratio", "cost_peer_ratio", "best_peer",
-                   "best_peer_ratio", "success_below_peer"]
+                   "best_peer_ratio", "best_peer_ratio_lo", "best_peer_ratio_hi",
+                   "success_below_peer"]
 SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "worst_ratio",
                    "best_ratio", "problems_lost", "worst_success_rate",
                    "problems_success_below_rrt", "median_cost_ratio", "median_time_ratio",
@@ -82,7 +88,8 @@ SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "wors
                    "median_work", "median_work_total", "caches", "median_cost_peer_ratio",
                    "worst_cost_peer_ratio", "problems_longer_than_peer", "best_peers",
                    "median_best_peer_ratio", "geomean_best_peer_ratio", "worst_best_peer_ratio",
-                   "problems_lost_best_peer", "problems_success_below_peer"]
+                   "problems_lost_best_peer", "problems_surely_lost_best_peer",
+                   "problems_surely_won_best_peer", "problems_success_below_peer"]
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "cost_deg", "wall_s",
                "time_total_s", "work", "work_total", "planner_used", "rulebook",
                "rulebook_sha256"]
@@ -250,20 +257,23 @@ def problem_table(runs: pd.DataFrame, order: list[str], peers=()) -> pd.DataFram
                                / per["median_work_total"])
     # path length against the same peer, planner / peer (< 1: shorter), like cost_ratio
     per["cost_peer_ratio"] = per["median_cost_deg"] / per["scenario"].map(peer["median_cost_deg"])
-    _best_peer_columns(per, peers)
+    _best_peer_columns(per, peers, runs)
     per["planner"] = pd.Categorical(per["planner"], categories=order, ordered=True)
     per = per.sort_values(["planner", "scenario"], kind="stable").reset_index(drop=True)
     per["planner"] = per["planner"].astype(str)
     return per[PROBLEM_COLUMNS]
 
 
-def _best_peer_columns(per: pd.DataFrame, peers) -> None:
-    """``best_peer``, ``best_peer_ratio`` and ``success_below_peer`` of each row of *per* (one
-    row per scenario and planner), in place; empty without peers among the planners that ran.
-    A failed run counts with the time it spent (as ``time_total_ratio``)."""
+def _best_peer_columns(per: pd.DataFrame, peers, runs: pd.DataFrame) -> None:
+    """``best_peer``, ``best_peer_ratio`` (with its bootstrap interval ``best_peer_ratio_lo``
+    .. ``_hi``, :mod:`xfuzzy_rrt.bench.interval`, from the *runs*) and ``success_below_peer``
+    of each row of *per* (one row per scenario and planner), in place; empty without peers
+    among the planners that ran. A failed run counts with the time it spent (as
+    ``time_total_ratio``)."""
     peers = [p for p in dict.fromkeys(peers) if p in set(per["planner"]) and p != BASELINE]
     if not peers:
         per["best_peer"], per["best_peer_ratio"], per["success_below_peer"] = None, np.nan, False
+        per["best_peer_ratio_lo"] = per["best_peer_ratio_hi"] = np.nan
         return
     mine = per[per["planner"].isin(peers)]
     times = mine.pivot(index="scenario", columns="planner", values="median_time_total_s")
@@ -273,6 +283,13 @@ def _best_peer_columns(per: pd.DataFrame, peers) -> None:
     per["best_peer_ratio"] = per["scenario"].map(times.min(axis=1)) / per["median_time_total_s"]
     per["success_below_peer"] = (per["success_rate"]
                                  < per["scenario"].map(success.max(axis=1)) - 1e-12)
+    times_of = {k: g.to_numpy(dtype=float)
+                for k, g in runs.groupby(["scenario", "planner"], sort=False)["time_total_s"]}
+    bounds = [median_ratio_interval(times_of[(sc, peer)], times_of[(sc, planner)],
+                                    f"{sc}\0{planner}")
+              for sc, planner, peer in zip(per["scenario"], per["planner"], per["best_peer"])]
+    per["best_peer_ratio_lo"] = [lo for lo, _ in bounds]
+    per["best_peer_ratio_hi"] = [hi for _, hi in bounds]
 
 
 def time_work_baseline(planners) -> str:
@@ -341,6 +358,8 @@ def summary_table(problems: pd.DataFrame, caches: str = "") -> pd.DataFrame:
             "geomean_best_peer_ratio": float(np.exp(np.log(b).mean())) if b.size else np.nan,
             "worst_best_peer_ratio": float(b.min()) if b.size else np.nan,
             "problems_lost_best_peer": int((b < 1.0).sum()),
+            "problems_surely_lost_best_peer": int((g["best_peer_ratio_hi"] < 1.0).sum()),
+            "problems_surely_won_best_peer": int((g["best_peer_ratio_lo"] > 1.0).sum()),
             "problems_success_below_peer": int(g["success_below_peer"].astype(bool).sum()),
         })
     frame = pd.DataFrame(rows, columns=SUMMARY_COLUMNS)

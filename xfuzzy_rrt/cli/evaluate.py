@@ -152,13 +152,16 @@ def evaluate(
     ours = result.summary[~result.summary["planner"].isin([*peers, "rrt"])]
     if peers and len(ours):
         typer.echo(f"Against the fastest of {', '.join(peers)} on each problem (its median "
-                   "end-to-end time / the planner's; success below: problems where some peer's "
-                   "certified success is higher):")
-        _table(["planner", "median", "geomean", "worst", "lost", "success below", "fastest peer"],
+                   "end-to-end time / the planner's; surely lost/won: its 95 % bootstrap interval "
+                   "over the seeds lies wholly below/above 1; success below: problems where some "
+                   "peer's certified success is higher):")
+        _table(["planner", "median", "geomean", "worst", "lost", "surely lost", "surely won",
+                "success below", "fastest peer"],
                [[r.planner, _fmt(r.median_best_peer_ratio, "x"),
                  _fmt(r.geomean_best_peer_ratio, "x"), _fmt(r.worst_best_peer_ratio, "x"),
-                 f"{r.problems_lost_best_peer}/{r.problems}", str(r.problems_success_below_peer),
-                 r.best_peers] for r in ours.itertuples()])
+                 f"{r.problems_lost_best_peer}/{r.problems}",
+                 str(r.problems_surely_lost_best_peer), str(r.problems_surely_won_best_peer),
+                 str(r.problems_success_below_peer), r.best_peers] for r in ours.itertuples()])
     if out is not None:
         typer.echo(f"wrote {out}/runs.csv, problems.csv, summary.csv")
     return 0

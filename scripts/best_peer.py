@@ -8,7 +8,8 @@ run counts with the time it spent) of the peers ``rrt:tuned``, ``ompl:RRTConnect
 ``ompl:BITstar`` that ran, and for each ``fuzzy-rrt*`` planner that best peer's median over its
 own: median, geometric mean and worst over problems, how many problems it loses, on how many
 its certified success is below some peer's, its median path cost over the tuned RRT's, and
-which peer was fastest where.
+which peer was fastest where; with each median its 95 % bootstrap interval over problems and
+with the losses those that are sure (``bench/interval.py``).
 
     python scripts/best_peer.py reports/eval/result-sample
 """
@@ -31,11 +32,13 @@ def main(folder: str) -> None:
     summary = summary_table(problem_table(runs, order, peers)).set_index("planner")
     for p in (p for p in order if p.startswith("fuzzy-rrt")):
         r = summary.loc[p]
-        print(f"{p:28s} vs best peer: median {r.median_best_peer_ratio:.2f}x  geomean "
+        print(f"{p:28s} vs best peer: median {r.median_best_peer_ratio:.2f}x "
+              f"[{r.median_best_peer_ratio_lo:.2f}-{r.median_best_peer_ratio_hi:.2f}]  geomean "
               f"{r.geomean_best_peer_ratio:.2f}x  worst {r.worst_best_peer_ratio:.2f}x  lost "
               f"{r.problems_lost_best_peer}/{r.problems} (surely {r.problems_surely_lost_best_peer}; "
               f"surely won {r.problems_surely_won_best_peer})  success below a peer on "
-              f"{r.problems_success_below_peer}  cost/rrt:tuned {r.median_cost_peer_ratio:.3f}  "
+              f"{r.problems_success_below_peer}  cost/rrt:tuned {r.median_cost_peer_ratio:.3f} "
+              f"[{r.median_cost_peer_ratio_lo:.3f}-{r.median_cost_peer_ratio_hi:.3f}]  "
               f"min success {r.worst_success_rate:.0%}")
     print("fastest peer per problem:", summary.iloc[0].best_peers)
 

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from xfuzzy_rrt.bench.interval import median_ratio_interval
+from xfuzzy_rrt.bench.interval import median_interval, median_ratio_interval
 from xfuzzy_rrt.bench.protocol import problem_table, summary_table
 
 
@@ -122,3 +122,23 @@ def test_the_noise_floor_script_refuses_a_folder_without_runs_in_one_line(tmp_pa
     assert _noise_floor_script().main([str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(tmp_path) in err[0] and "runs.csv" in err[0]
+
+
+def test_a_familys_median_comes_with_its_interval_over_problems(table):
+    _, problems = table
+    row = summary_table(problems).set_index("planner").loc["mine"]
+    assert row["median_best_peer_ratio_lo"] <= row["median_best_peer_ratio"] \
+        <= row["median_best_peer_ratio_hi"]
+    # three problems this far apart: the median could be any of them
+    r = problems[problems["planner"] == "mine"]["best_peer_ratio"]
+    assert row["median_best_peer_ratio_lo"] == pytest.approx(r.min())
+    assert row["median_best_peer_ratio_hi"] == pytest.approx(r.max())
+    assert row["median_cost_peer_ratio_lo"] == row["median_cost_peer_ratio_hi"] == 1.0
+
+
+def test_the_median_interval_narrows_with_more_problems():
+    rng = np.random.default_rng(3)
+    few = median_interval(rng.lognormal(0.0, 0.3, 12), "k")
+    many = median_interval(rng.lognormal(0.0, 0.3, 480), "k")
+    assert many[1] - many[0] < 0.5 * (few[1] - few[0])
+    assert all(np.isnan(median_interval([np.nan], "k")))

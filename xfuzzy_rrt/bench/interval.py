@@ -11,6 +11,10 @@ interval, and counts a problem *surely lost* only when the whole interval lies b
 *surely won* when it lies above). By chance alone about 2.5 % of problems fall on each side (one
 of 48); the self-comparison above puts 0-4 of 48 wholly off 1, both sides together.
 
+The same resampling over *problems* bounds a family's median (:func:`median_interval`): the
+mission's warning that 24 problems swing a median by +-20 % is what its width shows, and it says
+whether a median cost ratio of 1.02 is a miss or a toss.
+
 The method: resample the planner's runs and the peer's runs, each with replacement and
 independently (the two planners share seeds, but not what a seed makes them do, so their runs
 are not pairs), take the ratio of the two medians, and read the 2.5 % and 97.5 % quantiles of
@@ -32,6 +36,31 @@ RESAMPLES = 2000
 LEVEL = 0.95
 
 
+def median_interval(values, key: str, level: float = LEVEL,
+                    resamples: int = RESAMPLES) -> tuple[float, float]:
+    """``(lo, hi)``: the percentile-bootstrap interval of ``median(values)`` at *level*,
+    resampling the values (a family's per-problem ratios: how far the median could move had
+    other problems of the family been drawn); *key* seeds the draws. ``(nan, nan)`` without
+    finite values (the others are left out)."""
+    v = np.asarray(values, dtype=np.float64)
+    v = np.sort(v[np.isfinite(v)])
+    if v.size == 0:
+        return float("nan"), float("nan")
+    _check(level, resamples)
+    rng = np.random.default_rng(zlib.crc32(key.encode("utf-8")))
+    medians = np.median(v[rng.integers(0, v.size, (resamples, v.size))], axis=1)
+    tail = (1.0 - level) / 2.0
+    lo, hi = np.quantile(medians, [tail, 1.0 - tail])
+    return float(lo), float(hi)
+
+
+def _check(level: float, resamples: int) -> None:
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"level must lie in (0, 1), got {level}")
+    if resamples < 1:
+        raise ValueError(f"resamples must be at least 1, got {resamples}")
+
+
 def median_ratio_interval(numerator, denominator, key: str, level: float = LEVEL,
                           resamples: int = RESAMPLES) -> tuple[float, float]:
     """``(lo, hi)``: the percentile-bootstrap interval of ``median(numerator) /
@@ -43,10 +72,7 @@ def median_ratio_interval(numerator, denominator, key: str, level: float = LEVEL
     b = np.sort(np.asarray(denominator, dtype=np.float64))
     if a.size == 0 or b.size == 0 or not (np.isfinite(a).all() and np.isfinite(b).all()):
         return float("nan"), float("nan")
-    if not 0.0 < level < 1.0:
-        raise ValueError(f"level must lie in (0, 1), got {level}")
-    if resamples < 1:
-        raise ValueError(f"resamples must be at least 1, got {resamples}")
+    _check(level, resamples)
     rng = np.random.default_rng(zlib.crc32(key.encode("utf-8")))
     top = np.median(a[rng.integers(0, a.size, (resamples, a.size))], axis=1)
     bottom = np.median(b[rng.integers(0, b.size, (resamples, b.size))], axis=1)

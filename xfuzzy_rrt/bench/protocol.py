@@ -50,7 +50,10 @@ problems with success below a peer, and which peers were fastest where (``best_p
 ratio comes with its 95 % bootstrap interval over the seeds (``best_peer_ratio_lo``/``_hi``,
 :mod:`xfuzzy_rrt.bench.interval`), and a problem counts as *surely* lost (won) only when the
 whole interval lies below (above) 1: with a few dozen seeds of runs lasting microseconds, a
-ratio of 0.8x can be a coin toss. Path length is compared with
+ratio of 0.8x can be a coin toss. The medians over problems of the ratio to the fastest peer
+and of ``cost_peer_ratio`` come with the 95 % bootstrap interval over problems
+(``median_best_peer_ratio_lo``/``_hi``, ``median_cost_peer_ratio_lo``/``_hi``): how far the
+median would move on other problems of the same family. Path length is compared with
 the same peer too (``cost_peer_ratio`` = planner's median cost / the peer's, < 1: shorter;
 summarised as median, worst = largest, and how many problems are longer): issue 25's aim is a
 median path cost no higher than the tuned RRT's, and ``cost_ratio`` compares with the paper's
@@ -71,7 +74,7 @@ import numpy as np
 import pandas as pd
 
 from xfuzzy_rrt.bench.caches import DEFAULT_CACHE_MODE, CacheEvictor, check_cache_mode
-from xfuzzy_rrt.bench.interval import median_ratio_interval
+from xfuzzy_rrt.bench.interval import median_interval, median_ratio_interval
 
 PROBLEM_COLUMNS = ["scenario", "planner", "runs", "success_rate", "median_iterations",
                    "median_cost_deg", "median_time_s", "iteration_ratio", "cost_ratio",
@@ -86,8 +89,10 @@ SUMMARY_COLUMNS = ["planner", "problems", "median_ratio", "geomean_ratio", "wors
                    "worst_time_total_ratio", "problems_lost_time", "median_work_total_ratio",
                    "worst_work_total_ratio", "problems_lost_work_total", "median_time_total_s",
                    "median_work", "median_work_total", "caches", "median_cost_peer_ratio",
+                   "median_cost_peer_ratio_lo", "median_cost_peer_ratio_hi",
                    "worst_cost_peer_ratio", "problems_longer_than_peer", "best_peers",
-                   "median_best_peer_ratio", "geomean_best_peer_ratio", "worst_best_peer_ratio",
+                   "median_best_peer_ratio", "median_best_peer_ratio_lo",
+                   "median_best_peer_ratio_hi", "geomean_best_peer_ratio", "worst_best_peer_ratio",
                    "problems_lost_best_peer", "problems_surely_lost_best_peer",
                    "problems_surely_won_best_peer", "problems_success_below_peer"]
 RUN_COLUMNS = ["scenario", "planner", "seed", "success", "iterations", "cost_deg", "wall_s",
@@ -344,14 +349,18 @@ def summary_table(problems: pd.DataFrame, caches: str = "") -> pd.DataFrame:
         })
         c = g["cost_peer_ratio"].to_numpy(dtype=float)
         c = c[np.isfinite(c)]
+        c_lo, c_hi = median_interval(c, f"{planner}\0cost")
         rows[-1].update({
             "median_cost_peer_ratio": float(np.median(c)) if c.size else np.nan,
+            "median_cost_peer_ratio_lo": c_lo, "median_cost_peer_ratio_hi": c_hi,
             "worst_cost_peer_ratio": float(c.max()) if c.size else np.nan,
             "problems_longer_than_peer": int((c > 1.0).sum()),
         })
         b = g["best_peer_ratio"].to_numpy(dtype=float)
         b = b[np.isfinite(b) & (b > 0)]
+        b_lo, b_hi = median_interval(b, f"{planner}\0time")
         rows[-1].update({
+            "median_best_peer_ratio_lo": b_lo, "median_best_peer_ratio_hi": b_hi,
             "best_peers": ", ".join(f"{k} {v}" for k, v in
                                     g["best_peer"].dropna().value_counts().items()),
             "median_best_peer_ratio": float(np.median(b)) if b.size else np.nan,

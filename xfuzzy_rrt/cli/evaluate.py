@@ -152,12 +152,14 @@ def evaluate(
     ours = result.summary[~result.summary["planner"].isin([*peers, "rrt"])]
     if peers and len(ours):
         typer.echo(f"Against the fastest of {', '.join(peers)} on each problem (its median "
-                   "end-to-end time / the planner's; surely lost/won: its 95 % bootstrap interval "
-                   "over the seeds lies wholly below/above 1; success below: problems where some "
-                   "peer's certified success is higher):")
+                   "end-to-end time / the planner's; [a-b]: 95 % bootstrap interval of the median "
+                   "over problems; surely lost/won: the ratio's interval over the seeds lies "
+                   "wholly below/above 1; success below: problems where some peer's certified "
+                   "success is higher):")
         _table(["planner", "median", "geomean", "worst", "lost", "surely lost", "surely won",
                 "success below", "fastest peer"],
-               [[r.planner, _fmt(r.median_best_peer_ratio, "x"),
+               [[r.planner, _fmt(r.median_best_peer_ratio, "x")
+                 + f" [{_fmt(r.median_best_peer_ratio_lo)}-{_fmt(r.median_best_peer_ratio_hi)}]",
                  _fmt(r.geomean_best_peer_ratio, "x"), _fmt(r.worst_best_peer_ratio, "x"),
                  f"{r.problems_lost_best_peer}/{r.problems}",
                  str(r.problems_surely_lost_best_peer), str(r.problems_surely_won_best_peer),

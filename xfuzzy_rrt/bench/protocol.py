@@ -290,8 +290,9 @@ def _best_peer_columns(per: pd.DataFrame, peers, runs: pd.DataFrame) -> None:
                                  < per["scenario"].map(success.max(axis=1)) - 1e-12)
     times_of = {k: g.to_numpy(dtype=float)
                 for k, g in runs.groupby(["scenario", "planner"], sort=False)["time_total_s"]}
-    bounds = [median_ratio_interval(times_of[(sc, peer)], times_of[(sc, planner)],
-                                    f"{sc}\0{planner}")
+    none = np.empty(0)  # a problem no peer ran on (a partial runs table): no interval
+    bounds = [median_ratio_interval(times_of.get((sc, peer), none),
+                                    times_of.get((sc, planner), none), f"{sc}\0{planner}")
               for sc, planner, peer in zip(per["scenario"], per["planner"], per["best_peer"])]
     per["best_peer_ratio_lo"] = [lo for lo, _ in bounds]
     per["best_peer_ratio_hi"] = [hi for _, hi in bounds]

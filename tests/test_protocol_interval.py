@@ -142,3 +142,14 @@ def test_the_median_interval_narrows_with_more_problems():
     many = median_interval(rng.lognormal(0.0, 0.3, 480), "k")
     assert many[1] - many[0] < 0.5 * (few[1] - few[0])
     assert all(np.isnan(median_interval([np.nan], "k")))
+
+
+def test_a_problem_no_peer_ran_on_has_no_interval():
+    rng = np.random.default_rng(5)
+    runs = _runs({("a", "rrt"): _noisy(rng, 5.0, 10), ("a", "rrt:tuned"): _noisy(rng, 1.0, 10),
+                  ("a", "mine"): _noisy(rng, 1.0, 10), ("b", "rrt"): _noisy(rng, 5.0, 10),
+                  ("b", "mine"): _noisy(rng, 1.0, 10)})
+    problems = problem_table(runs, ["rrt", "rrt:tuned", "mine"], ["rrt:tuned"])
+    mine = problems[problems["planner"] == "mine"].set_index("scenario")
+    assert np.isfinite(mine.loc["a", "best_peer_ratio_lo"])
+    assert np.isnan(mine.loc["b", "best_peer_ratio_lo"]) and np.isnan(mine.loc["b", "best_peer_ratio_hi"])

@@ -94,3 +94,9 @@ def test_evaluate_prints_the_fastest_peer_table_from_its_own_summary(tmp_path):
                 and "/2" in ln)
     assert f"{row['median_best_peer_ratio']:.3g}x" in line
     assert f"{row['problems_lost_best_peer']}/2" in line
+    # the median's interval over problems, as the summary has it, and the sure counts' columns
+    assert (f"[{row['median_best_peer_ratio_lo']:.3g}-{row['median_best_peer_ratio_hi']:.3g}]"
+            in line)
+    header = next(ln for ln in proc.stdout.splitlines() if ln.startswith("planner")
+                  and "surely lost" in ln)
+    assert "surely won" in header

@@ -152,4 +152,5 @@ def test_a_problem_no_peer_ran_on_has_no_interval():
     problems = problem_table(runs, ["rrt", "rrt:tuned", "mine"], ["rrt:tuned"])
     mine = problems[problems["planner"] == "mine"].set_index("scenario")
     assert np.isfinite(mine.loc["a", "best_peer_ratio_lo"])
-    assert np.isnan(mine.loc["b", "best_peer_ratio_lo"]) and np.isnan(mine.loc["b", "best_peer_ratio_hi"])
+    assert np.isnan(mine.loc["b", "best_peer_ratio_lo"])
+    assert np.isnan(mine.loc["b", "best_peer_ratio_hi"])

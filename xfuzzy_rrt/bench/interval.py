@@ -3,13 +3,14 @@
 Why: issue 25's aims are per problem ("worst >= 1x on every problem"), and a per-problem ratio
 is the ratio of two medians over a finite set of seeds, each with its timing noise. On the
 2-joint families a run takes a few dozen microseconds and its time varies several-fold from
-seed to seed, so the default measured against *itself* -- its 25 even seeds against its 25 odd ones --
-already "loses" some problem among 48 by 0.64-0.84x (``scripts/noise_floor.py``;
-docs/peer-measurements.md, twentieth session). A count of problems lost cannot tell such a coin toss from a real loss; an interval
-can. ``evaluate`` reports, beside each ratio to the fastest peer, the 95 % percentile-bootstrap
-interval, and counts a problem *surely lost* only when the whole interval lies below 1 (and
-*surely won* when it lies above). By chance alone about 2.5 % of problems fall on each side (one
-of 48); the self-comparison above puts 0-4 of 48 wholly off 1, both sides together.
+seed to seed, so the default measured against *itself* -- its 25 even seeds against its 25 odd
+ones -- already "loses" some problem among 48 by 0.64-0.84x (``scripts/noise_floor.py``;
+docs/peer-measurements.md, twentieth session). A count of problems lost cannot tell such a coin
+toss from a real loss; an interval can. ``evaluate`` reports, beside each ratio to the fastest
+peer, the 95 % percentile-bootstrap interval, and counts a problem *surely lost* only when the
+whole interval lies below 1 (and *surely won* when it lies above). By chance alone about 2.5 %
+of problems fall on each side (one of 48); the self-comparisons of two sittings put 0-5 of 48
+wholly off 1, both sides together.
 
 The same resampling over *problems* bounds a family's median (:func:`median_interval`): the
 mission's warning that 24 problems swing a median by +-20 % is what its width shows, and it says

@@ -17,6 +17,7 @@ with the losses those that are sure (``bench/interval.py``).
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import pandas as pd
 
@@ -25,8 +26,12 @@ from xfuzzy_rrt.bench.protocol import problem_table, summary_table
 PEERS = ("rrt:tuned", "ompl:RRTConnect", "ompl:BITstar")
 
 
-def main(folder: str) -> None:
-    runs = pd.read_csv(f"{folder}/runs.csv")
+def main(folder: str) -> int:
+    if not Path(folder, "runs.csv").is_file():
+        print(f"error: {folder}: no runs.csv (give an 'xfuzzy-rrt evaluate --out' folder)",
+              file=sys.stderr)
+        return 2
+    runs = pd.read_csv(Path(folder, "runs.csv"))
     order = list(dict.fromkeys(runs["planner"]))
     peers = [p for p in PEERS if p in order]
     summary = summary_table(problem_table(runs, order, peers)).set_index("planner")
@@ -42,9 +47,10 @@ def main(folder: str) -> None:
               f"[{r.median_cost_peer_ratio_lo:.3f}-{r.median_cost_peer_ratio_hi:.3f}]  "
               f"min success {r.worst_success_rate:.0%}")
     print("fastest peer per problem:", summary.iloc[0].best_peers)
+    return 0
 
 
 if __name__ == "__main__":
     if len(sys.argv) != 2:
         sys.exit("usage: python scripts/best_peer.py EVALUATE_OUT_FOLDER")
-    main(sys.argv[1])
+    sys.exit(main(sys.argv[1]))

@@ -100,3 +100,15 @@ def test_evaluate_prints_the_fastest_peer_table_from_its_own_summary(tmp_path):
     header = next(ln for ln in proc.stdout.splitlines() if ln.startswith("planner")
                   and "surely lost" in ln)
     assert "surely won" in header
+
+
+def test_the_best_peer_script_refuses_a_folder_without_runs_in_one_line(tmp_path, capsys):
+    import importlib.util
+
+    path = FIXTURES.parents[1] / "scripts" / "best_peer.py"
+    spec = importlib.util.spec_from_file_location("best_peer", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.main(str(tmp_path)) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(tmp_path) in err[0] and "runs.csv" in err[0]

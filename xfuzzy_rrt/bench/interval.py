@@ -48,11 +48,8 @@ def median_interval(values, key: str, level: float = LEVEL,
     if v.size == 0:
         return float("nan"), float("nan")
     _check(level, resamples)
-    rng = np.random.default_rng(zlib.crc32(key.encode("utf-8")))
-    medians = np.median(v[rng.integers(0, v.size, (resamples, v.size))], axis=1)
-    tail = (1.0 - level) / 2.0
-    lo, hi = np.quantile(medians, [tail, 1.0 - tail])
-    return float(lo), float(hi)
+    rng = _draws(key)
+    return _bounds(_resampled_medians(v, rng, resamples), level)
 
 
 def _check(level: float, resamples: int) -> None:
@@ -60,6 +57,23 @@ def _check(level: float, resamples: int) -> None:
         raise ValueError(f"level must lie in (0, 1), got {level}")
     if resamples < 1:
         raise ValueError(f"resamples must be at least 1, got {resamples}")
+
+
+def _draws(key: str) -> np.random.Generator:
+    """The generator of one interval's draws, seeded by its *key* alone."""
+    return np.random.default_rng(zlib.crc32(key.encode("utf-8")))
+
+
+def _resampled_medians(v: np.ndarray, rng: np.random.Generator, resamples: int) -> np.ndarray:
+    """Medians of *resamples* resamples of *v* with replacement."""
+    return np.median(v[rng.integers(0, v.size, (resamples, v.size))], axis=1)
+
+
+def _bounds(draws: np.ndarray, level: float) -> tuple[float, float]:
+    """The two-sided percentile interval of *draws* at *level*."""
+    tail = (1.0 - level) / 2.0
+    lo, hi = np.quantile(draws, [tail, 1.0 - tail])
+    return float(lo), float(hi)
 
 
 def median_ratio_interval(numerator, denominator, key: str, level: float = LEVEL,
@@ -74,11 +88,8 @@ def median_ratio_interval(numerator, denominator, key: str, level: float = LEVEL
     if a.size == 0 or b.size == 0 or not (np.isfinite(a).all() and np.isfinite(b).all()):
         return float("nan"), float("nan")
     _check(level, resamples)
-    rng = np.random.default_rng(zlib.crc32(key.encode("utf-8")))
-    top = np.median(a[rng.integers(0, a.size, (resamples, a.size))], axis=1)
-    bottom = np.median(b[rng.integers(0, b.size, (resamples, b.size))], axis=1)
+    rng = _draws(key)
+    top = _resampled_medians(a, rng, resamples)
+    bottom = _resampled_medians(b, rng, resamples)
     with np.errstate(divide="ignore", invalid="ignore"):
-        ratios = top / bottom
-    tail = (1.0 - level) / 2.0
-    lo, hi = np.quantile(ratios, [tail, 1.0 - tail])
-    return float(lo), float(hi)
+        return _bounds(top / bottom, level)

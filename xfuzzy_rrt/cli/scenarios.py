@@ -49,8 +49,10 @@ def generate(
         raise InputError("--prefix", f"must be letters, digits, '-' or '_', got {prefix!r}")
     if out.exists() and not out.is_dir():
         raise InputError(str(out), "exists and is not a directory")
-    for k in range(count):
-        problem = generate_one(seed, k, prefix, family, dof=dof, arms=arms)
+    # every problem first, then the files: a seed that has no problem k (NoProblemFound, one
+    # line and exit 2) leaves no part of the set behind
+    problems = [generate_one(seed, k, prefix, family, dof=dof, arms=arms) for k in range(count)]
+    for problem in problems:
         path = out / f"{problem.scenario.name}.toml"
         write_text_atomic(path, problem.text)
         if nd:

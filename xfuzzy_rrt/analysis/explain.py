@@ -80,6 +80,11 @@ class Explanation:
         return worst
 
 
+#: What explaining a run of no iteration says: a planner whose start is its goal returns the
+#: path ``[start, goal]`` before its first iteration (planners/extend.py, join_start_at_goal).
+NO_ITERATION = "the run made no iteration (its start is its goal), so no decision to explain"
+
+
 def load_trace(path: str | Path) -> pd.DataFrame:
     """Read a trace written by ``plan --trace`` (Parquet or CSV by suffix)."""
     path = Path(path)
@@ -137,6 +142,8 @@ def explain_rows(row: pd.Series, rulebook) -> list[Explanation]:
 
 
 def trace_row(frame: pd.DataFrame, iteration: int, where: str = "--iteration") -> pd.Series:
+    if len(frame) == 0:
+        raise InputError(where, NO_ITERATION)
     rows = frame.index[frame["iteration"] == iteration]
     if len(rows) == 0:
         raise InputError(where, f"iteration {iteration} is not in the trace "

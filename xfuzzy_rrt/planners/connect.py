@@ -77,7 +77,7 @@ from xfuzzy_rrt.fuzzy.semantics import length_scale
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
-from xfuzzy_rrt.planners.extend import extend, node_clearance
+from xfuzzy_rrt.planners.extend import extend, join_start_at_goal, node_clearance
 from xfuzzy_rrt.planners.goal_frame import (
     REJECT_DECAY,
     _joint_dist,
@@ -192,6 +192,10 @@ def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, sto
 
     add_node(TA, P.start, -1)
     add_node(TB, P.goal, -1)
+    g = join_start_at_goal(P, TA)
+    if g >= 0:  # the start is the goal: [start, goal], joined at the goal tree's root
+        counts[0] = 0
+        return True, 0, g, 0
     if has_obstacles:  # the roots' clearance, once; every other node keeps the one it was
         TA.clear[0] = node_clearance(P, TA, 0)  # accepted with (extend)
         TB.clear[0] = node_clearance(PR, TB, 0)

@@ -169,3 +169,26 @@ def node_clearance(P, T, i):
     if T.link_clear.shape[1] == stop_width(P):  # and its stop record (extend)
         return node_stop_into(P, q, T.seg, T.mks, T.msf, T.link_clear, i)
     return clearance_into(P, q, T.seg)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def join_start_at_goal(P, T):
+    """When the start *is* the goal, the path is ``[start, goal]``, of length zero: add the goal
+    as the root's child and return its index (a planner returns success after 0 iterations);
+    otherwise -1, and nothing is measured or added.
+
+    Why: a problem that asks the arm to stay where it is got a path that went away and came back
+    (166 deg from ``fuzzy-rrt``, 14 deg from ``rrt``), because a planner only looks for the goal
+    at the nodes it adds, never at the root. The zero-length edge is certified as every node is:
+    the start's clearance (:func:`node_clearance`, counted in the work) must exceed the margin;
+    a start that does not keep it returns -1, and the run goes on as before (it can find no
+    path). ``T`` holds only the root."""
+    for j in range(P.start.shape[0]):
+        if P.start[j] != P.goal[j]:
+            return -1
+    c = node_clearance(P, T, 0)
+    if not c > P.margin:
+        return -1
+    g = add_node(T, P.goal, 0)
+    T.clear[g] = c
+    return g

@@ -63,7 +63,7 @@ from xfuzzy_rrt.geometry.kinematics import arm_end_effector
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
-from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.params import default
 from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
@@ -211,6 +211,9 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
     has_obstacles = P.obstacles.shape[0] > 0 or n_arms > 1
 
     add_node(T, P.start, -1)
+    g = join_start_at_goal(P, T)
+    if g >= 0:
+        return True, 0, g
     current = 0  # the paper's nearest_node: the start at iteration 1
     for it in range(1, max_iter + 1):
         if stop[0] != 0:

@@ -46,7 +46,7 @@ import numpy as np
 
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
-from xfuzzy_rrt.planners.extend import extend, node_clearance
+from xfuzzy_rrt.planners.extend import extend, join_start_at_goal, node_clearance
 from xfuzzy_rrt.planners.result import ACCEPTED, EDGE_BLOCKED, GOAL_REACHED, NODE_IN_COLLISION
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.trace_record import record_iteration
@@ -200,6 +200,9 @@ def _goal_frame_loop(P, T, seed, max_iter, knots, consts, min_step, stop, TR, st
     has_obstacles = P.obstacles.shape[0] > 0 or P.arm_first.shape[0] > 2
 
     add_node(T, P.start, -1)
+    g = join_start_at_goal(P, T)
+    if g >= 0:
+        return True, 0, g
     if has_obstacles:
         T.clear[0] = node_clearance(P, T, 0)
     current = 0

@@ -17,12 +17,14 @@ from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 
 def trace_for(source: Path, rulebook: Path | None = None):
     """Return ``(trace DataFrame, Rulebook)`` for a trace file or a plan-result JSON."""
-    from xfuzzy_rrt.analysis.explain import load_trace
+    from xfuzzy_rrt.analysis.explain import NO_ITERATION, load_trace
 
     source = Path(source)
     if source.suffix.lower() == ".json":
         return _replay_result(source, rulebook)
     frame = load_trace(source)
+    if len(frame) == 0:  # its rows name the rulebook; a run of no iteration has none
+        raise InputError(str(source), NO_ITERATION)
     if rulebook is None:
         return frame, _rulebook_of_trace(frame, source)
     return frame, load_rulebook(rulebook)

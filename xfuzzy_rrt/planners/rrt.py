@@ -20,7 +20,7 @@ import numpy as np
 from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
-from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.params import default
 from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
                                          finish_tree_run)
@@ -53,6 +53,9 @@ def _rrt_loop(P, T, seed, max_iter, step, goal_bias, stop, state, sample, q_near
     seed_state(seed, state)
     dof = P.start.shape[0]
     add_node(T, P.start, -1)
+    g = join_start_at_goal(P, T)
+    if g >= 0:
+        return True, 0, g
     for it in range(1, max_iter + 1):
         if stop[0] != 0:
             return False, it - 1, -1

@@ -127,8 +127,11 @@ def trace_frame(buffers, iterations: int, nodes: np.ndarray, parent: np.ndarray,
         pd.DataFrame(int_head, columns=_INT_HEAD, copy=False),
         pd.DataFrame(float_head, columns=float_cols, copy=False),
         extras,
-        pd.DataFrame(buffers.rule[:n].reshape(n, -1).astype(np.int64), columns=rule_cols, copy=False),
-        pd.DataFrame(buffers.w[:n].reshape(n, -1), columns=strength_cols, copy=False),
+        # (reshaped by the column count: a run of no iteration, the start at the goal, has n = 0)
+        pd.DataFrame(buffers.rule[:n].reshape(n, len(rule_cols)).astype(np.int64),
+                     columns=rule_cols, copy=False),
+        pd.DataFrame(buffers.w[:n].reshape(n, len(strength_cols)), columns=strength_cols,
+                     copy=False),
     ], axis=1)
 
 

@@ -35,7 +35,7 @@ import numpy as np
 from xfuzzy_rrt.fuzzy.engine import infer
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.kinematics import arm_end_effector
-from xfuzzy_rrt.planners.extend import extend
+from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.fuzzy_rrt import BOUNDS_RELATIVE, _interval, arm_inputs
 from xfuzzy_rrt.planners.result import ACCEPTED, GOAL_REACHED
 from xfuzzy_rrt.planners.rng import seed_state, uniform
@@ -70,6 +70,9 @@ def paper_run(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, memo, 
     has_obstacles = P.obstacles.shape[0] > 0 or n_arms > 1
 
     add_node(T, P.start, -1)
+    g = join_start_at_goal(P, T)
+    if g >= 0:
+        return True, 0
     current = 0
     goal_near = 0  # nearest(T, goal), kept up to date as nodes join
     goal_d2 = _d2(T.nodes, 0, P.goal)

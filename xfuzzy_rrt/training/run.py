@@ -296,6 +296,10 @@ def work_and_cost_baselines(scenarios: list[TrainingScenario], max_iter: int
     work, costs = tuned_rrt_baselines(problems, np.arange(BASELINE_RUNS), max_iter,
                                       "work-cost-cvar")
     for t, c in zip(scenarios, costs):
+        if c == 0.0:  # every path of length zero: the start is the goal
+            raise InputError(t.path, "the tuned RRT's paths have length zero (the start is the "
+                             "goal), so work-cost-cvar has no path cost to compare with: leave "
+                             "this scenario out")
         if not (np.isfinite(c) and c > 0):
             raise InputError(t.path, f"the tuned RRT found no path in {BASELINE_RUNS} runs of "
                              f"{max_iter} iterations, so work-cost-cvar has no path cost to "

@@ -118,3 +118,39 @@ def test_a_problem_whose_first_250_drafts_fail_is_still_found(monkeypatch):
     problem = gen.generate_nd(9900, 11, None, 2, 4)
     assert problem.scenario.name == "arms4-dof2-9900-011"
     assert 250 < len(drafts) <= gen.MAX_DRAWS_PER_PROBLEM
+
+
+# ---------------------------------------------------------------- needs the N-DOF planner core
+
+_SOLVED = re.compile(r"rrt solved it in (\d+) iterations \(seed (\d+)\)")
+
+
+@pytest.mark.parametrize("dof,arms", [(3, 1), (5, 1), (7, 1), (2, 2)])
+def test_generated_nd_problems_are_solved_by_a_certified_rrt_path(run_cli, tmp_path, dof, arms):
+    """Through the CLI, twice: same bytes; the recorded RRT run reproduces and is certified."""
+    from xfuzzy_rrt.planners.api import plan_scenario
+
+    extra = ["--dof", str(dof), "--arms", str(arms)]
+    for folder in ("a", "b"):
+        proc = run_cli("scenarios", "generate", "--count", "1", "--seed", "5",
+                       "--out", tmp_path / folder, *extra)
+        assert proc.returncode == 0, proc.stderr
+        # each N-DOF problem can take minutes: stderr says how far the command is
+        assert proc.stderr.rstrip().endswith(f"drafted 1 of 1: {gen.nd_prefix(dof, arms)}-5-000")
+    name = f"{gen.nd_prefix(dof, arms)}-5-000.toml"
+    text = (tmp_path / "a" / name).read_bytes()
+    assert text == (tmp_path / "b" / name).read_bytes()
+    s = load_scenario(tmp_path / "a" / name)
+    assert s.dof == dof * arms and len(s.arms) == arms
+    m = _SOLVED.search(s.description)
+    assert m, s.description
+    result = plan_scenario(s, "rrt", seed=int(m.group(2)), max_iter=gen.ND_RRT_BUDGET)
+    assert result.success and result.certified
+    assert result.iterations == int(m.group(1))
+    path = np.asarray(result.path_deg)
+    assert path.shape[1] == s.dof
+    np.testing.assert_array_equal(path[0], s.start_deg)
+    np.testing.assert_array_equal(path[-1], s.goal_deg)
+    a = s.arrays()
+    assert not segment_free(a, a.start_deg, a.goal_deg)
+    assert all(segment_free(a, p, q) for p, q in zip(path[:-1], path[1:]))

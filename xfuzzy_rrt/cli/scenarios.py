@@ -50,8 +50,13 @@ def generate(
     if out.exists() and not out.is_dir():
         raise InputError(str(out), "exists and is not a directory")
     # every problem first, then the files: a seed that has no problem k (NoProblemFound, one
-    # line and exit 2) leaves no part of the set behind
-    problems = [generate_one(seed, k, prefix, family, dof=dof, arms=arms) for k in range(count)]
+    # line and exit 2) leaves no part of the set behind. An N-DOF problem can take seconds to
+    # minutes (each draft is proved solvable by RRT), so those say on stderr how far they are.
+    problems = []
+    for k in range(count):
+        problems.append(generate_one(seed, k, prefix, family, dof=dof, arms=arms))
+        if nd:
+            typer.echo(f"drafted {k + 1} of {count}: {problems[-1].scenario.name}", err=True)
     for problem in problems:
         path = out / f"{problem.scenario.name}.toml"
         write_text_atomic(path, problem.text)

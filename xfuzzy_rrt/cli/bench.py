@@ -10,7 +10,8 @@ from typing import List, Optional
 
 import typer
 
-from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option, split_planners
+from xfuzzy_rrt.cli.common import (check_seed_option, check_workers_option, rulebook_arg,
+                                    split_planners)
 
 
 class ProgressBar:
@@ -129,8 +130,9 @@ def bench(
              "several side by side), ompl:NAME (e.g. ompl:RRTConnect)."),
     runs: int = typer.Option(50, "--runs", min=1, help="Runs per (scenario, planner)."),
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="First seed; run k uses seed + k."),
-    rulebook: Optional[Path] = typer.Option(None, "--rulebook",
-                                            help="Rulebook directory of plain fuzzy-rrt."),
+    rulebook: Optional[Path] = typer.Option(None, "--rulebook", callback=rulebook_arg,
+                                            help="Rulebook directory (or a shipped rulebook's "
+                                                 "name) of plain fuzzy-rrt."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget per run (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Output folder (default reports/bench-<time>)."),
     workers: int = typer.Option(1, "--workers", callback=check_workers_option, min=1, help="Worker processes."),

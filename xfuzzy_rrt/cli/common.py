@@ -131,3 +131,16 @@ def test_signal(point: str) -> None:
             os.killpg(os.getpgrp(), signal.SIGINT)
         else:
             os.kill(os.getpid(), signal.SIGINT)
+
+
+def rulebook_arg(value):
+    """Typer callback of every argument that names a rulebook to read: a shipped rulebook's name
+    is taken where a directory is (:func:`xfuzzy_rrt.fuzzy.rulebook.rulebook_path`); ``None``
+    and lists (repeatable options) pass through it element by element."""
+    from xfuzzy_rrt.fuzzy.rulebook import rulebook_path
+
+    if value is None:
+        return None
+    if isinstance(value, (list, tuple)):
+        return [rulebook_path(v) for v in value]
+    return rulebook_path(value)

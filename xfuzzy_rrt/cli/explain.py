@@ -7,12 +7,15 @@ from typing import Optional
 
 import typer
 
+from xfuzzy_rrt.cli.common import rulebook_arg
+
 
 def explain(
     source: Path = typer.Argument(..., help="A trace (.parquet/.csv) or a plan result (.json)."),
     iteration: int = typer.Option(..., "--iteration", min=1, help="Iteration to explain (1-based)."),
     rulebook: Optional[Path] = typer.Option(
-        None, "--rulebook", help="Rulebook that made the trace (default: the one the source names)."),
+        None, "--rulebook", callback=rulebook_arg,
+        help="Rulebook that made the trace, a directory or a shipped rulebook's name (default: the one the source names)."),
     exact: bool = typer.Option(False, "--exact", help="Full precision (every digit, to re-derive "
                                "the numbers bit for bit) instead of 4 significant digits."),
 ) -> int:

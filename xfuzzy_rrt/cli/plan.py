@@ -8,7 +8,7 @@ from typing import Optional
 
 import typer
 
-from xfuzzy_rrt.cli.common import check_seed_option
+from xfuzzy_rrt.cli.common import check_seed_option, rulebook_arg
 from xfuzzy_rrt.planners import registry as _registry
 
 #: What the help says takes a rulebook / records a trace (the planner registry's exact labels).
@@ -27,7 +27,7 @@ def plan(
         PlannerName.fuzzy_rrt.value, "--planner",
         help=_registry.planner_help()),
     rulebook: Optional[Path] = typer.Option(
-        None, "--rulebook", help=f"Rulebook directory ({_RULEBOOK_PLANNERS}; default: the shipped default of the problem: goal-frame for one 2-joint arm, else fuzzy-rrt-connect with goal-frame-any, as the JSON's planner_used and rulebook say)."),
+        None, "--rulebook", callback=rulebook_arg, help=f"Rulebook directory or a shipped rulebook's name ({_RULEBOOK_PLANNERS}; default: the shipped default of the problem: goal-frame for one 2-joint arm, else fuzzy-rrt-connect with goal-frame-any, as the JSON's planner_used and rulebook say)."),
     seed: int = typer.Option(0, "--seed", callback=check_seed_option, help="Random seed."),
     max_iter: int = typer.Option(10_000, "--max-iter", min=1, max=1_000_000, help="Iteration budget (at most 1,000,000)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON here (default: stdout)."),

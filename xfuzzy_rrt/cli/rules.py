@@ -15,7 +15,7 @@ from typing import List, Optional
 
 import typer
 
-from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option
+from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option, rulebook_arg
 
 app = typer.Typer(help="Inspect, validate, evaluate and convert rulebooks.", no_args_is_help=True)
 
@@ -35,7 +35,7 @@ def _out(text: str) -> None:
 
 @app.command("eval")
 def eval_(
-    rulebook: Path = typer.Argument(..., help="Rulebook directory."),
+    rulebook: Path = typer.Argument(..., help="Rulebook directory (or a shipped rulebook's name).", callback=rulebook_arg),
     input: Path = typer.Option(..., "--input", help="CSV with the rulebook's four inputs (paper: angle_to_goal, dist_to_goal, angle_to_obstacle, dist_to_obstacle)."),
     output: Path = typer.Option(..., "--output", help="CSV to write: the input rows with the rulebook's outputs appended (six at 2 DOF; goal_bias, bound_1 ... bound_2N, step_size for a paper rulebook of N joints)."),
 ) -> int:
@@ -83,7 +83,7 @@ def _eval_echo(result, rb, output: Path) -> str:
 
 
 @app.command("lint")
-def lint(rulebook: Path = typer.Argument(..., help="Rulebook directory.")) -> int:
+def lint(rulebook: Path = typer.Argument(..., help="Rulebook directory (or a shipped rulebook's name).", callback=rulebook_arg)) -> int:
     """Validate a rulebook; report every problem as FILE:LINE: problem (exit 2)."""
     from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 
@@ -110,7 +110,7 @@ def _readable(text: str, exact: bool) -> str:
 
 @app.command("show")
 def show(
-    rulebook: Path = typer.Argument(..., help="Rulebook directory."),
+    rulebook: Path = typer.Argument(..., help="Rulebook directory (or a shipped rulebook's name).", callback=rulebook_arg),
     when: Optional[List[str]] = typer.Option(
         None, "--when",
         help="List the rules matching INPUT=TERM conditions (repeatable or comma-separated), "
@@ -209,7 +209,7 @@ def show(
 
 @app.command("export")
 def export(
-    rulebook: Path = typer.Argument(..., help="Rulebook directory."),
+    rulebook: Path = typer.Argument(..., help="Rulebook directory (or a shipped rulebook's name).", callback=rulebook_arg),
     format: ExportFormat = typer.Option(ExportFormat.fll, "--format", help="Export format."),
     out: Path = typer.Option(..., "--out", help="Directory to write <output>.fll files into."),
 ) -> int:
@@ -281,7 +281,7 @@ def _expand_sources(sources: List[Path]) -> tuple[list[Path], list[Path]]:
 
 @app.command("coverage")
 def coverage(
-    rulebook: Path = typer.Argument(..., help="Rulebook directory."),
+    rulebook: Path = typer.Argument(..., help="Rulebook directory (or a shipped rulebook's name).", callback=rulebook_arg),
     sources: List[Path] = typer.Argument(..., help="Scenario TOML files or directories (planned "
                                          "--runs times each), or saved trace files (.parquet/.csv)."),
     runs: int = typer.Option(10, "--runs", min=1, help="Runs per scenario (seeds seed..seed+runs-1)."),
@@ -383,8 +383,8 @@ def _documentary_lines(doc, limit: int) -> list[str]:
 
 @app.command("diff")
 def diff(
-    a: Path = typer.Argument(..., help="Rulebook directory A."),
-    b: Path = typer.Argument(..., help="Rulebook directory B."),
+    a: Path = typer.Argument(..., help="Rulebook directory A (or a shipped rulebook's name).", callback=rulebook_arg),
+    b: Path = typer.Argument(..., help="Rulebook directory B (or a shipped rulebook's name).", callback=rulebook_arg),
     html: Optional[Path] = typer.Option(None, "--html", help="Write an HTML page of the differences."),
     out: Optional[Path] = typer.Option(None, "--out", help="CSV of every changed cell."),
     limit: int = typer.Option(50, "--limit", min=0, help="Changed cells to print per FIS."),
@@ -488,7 +488,7 @@ def _measures_text(before, after) -> str:
 
 @app.command("simplify")
 def simplify_cmd(
-    rulebook: Path = typer.Argument(..., help="Rulebook directory."),
+    rulebook: Path = typer.Argument(..., help="Rulebook directory (or a shipped rulebook's name).", callback=rulebook_arg),
     out: Path = typer.Option(..., "--out", help="Directory to write the simplified (compact) rulebook."),
     name: Optional[str] = typer.Option(None, "--name", help="Name of the new rulebook (default NAME-simplified)."),
     budget: Optional[str] = typer.Option(None, "--budget", help="Allow lossy steps within e.g. 'iterations+10%' "

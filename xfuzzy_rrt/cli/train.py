@@ -9,7 +9,7 @@ from typing import List, Optional
 
 import typer
 
-from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option
+from xfuzzy_rrt.cli.common import check_seed_option, check_workers_option, rulebook_arg
 
 
 class _Progress:
@@ -85,7 +85,7 @@ def train(
     block_rate: float = typer.Option(0.5, "--block-rate", help="Per-child probability of a term-block mutation."),
     block_sigma: float = typer.Option(0.05, "--block-sigma", help="Scale of term-block mutations (genes are in [0, 1])."),
     init: str = typer.Option("seeded", "--init", help="First generation: seeded (known rulebooks + perturbations) or random."),
-    seed_rulebook: Optional[List[Path]] = typer.Option(None, "--seed-rulebook", help="Rulebook directory the seeded first generation starts from (repeatable; default: the shipped expert when its bounds mode matches --bounds). Its SHA-256 is recorded."),
+    seed_rulebook: Optional[List[Path]] = typer.Option(None, "--seed-rulebook", callback=rulebook_arg, help="Rulebook directory (or a shipped rulebook's name) the seeded first generation starts from (repeatable; default: the shipped expert when its bounds mode matches --bounds). Its SHA-256 is recorded."),
     validation_runs: int = typer.Option(50, "--validation-runs", help="Runs per scenario to choose the final rulebook."),
     name: Optional[str] = typer.Option(None, "--name", help="Rulebook name (default: the --out folder's name)."),
     clearance: Optional[float] = typer.Option(None, "--clearance", help="Certified clearance in metres the planner must keep while training (default: each scenario's, else 0)."),

@@ -313,6 +313,24 @@ def rulebooks_dir() -> Path:
     return _shipped_rulebooks_dir()
 
 
+def rulebook_path(spec: str | os.PathLike[str]) -> Path:
+    """The directory a rulebook argument names: ``spec`` itself when it exists; else, for a bare
+    name (no path separator, not starting with ``.`` or ``~``), the shipped rulebook of that
+    name when there is one; else ``spec`` as given (:func:`load_rulebook` then says it does
+    not exist).
+
+    Why: ``evaluate --rulebook`` took a shipped name and ``plan --rulebook``, ``rules``,
+    ``explain --rulebook`` and ``train --seed-rulebook`` did not, so ``xfuzzy-rrt rules show
+    goal-frame`` failed anywhere but in the project's root. A folder of that name in the
+    current directory still wins (it is what the path names)."""
+    path = Path(spec)
+    text = os.fspath(spec)
+    if path.exists() or "/" in text or "\\" in text or text.startswith((".", "~")) or not text:
+        return path
+    shipped = rulebooks_dir() / text
+    return shipped if shipped.is_dir() else path
+
+
 @functools.cache
 def _shipped_rulebooks_dir() -> Path:
     """The package's own folder: asked of ``importlib.resources`` once per process (~0.5 ms a

@@ -14,11 +14,9 @@ from xfuzzy_rrt.cli.common import check_seed_option
 def _rulebook(spec: str):
     """A shipped rulebook's name, or a rulebook directory."""
     from xfuzzy_rrt.errors import InputError
-    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
+    from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebook_path
 
-    path = Path(spec)
-    if not path.exists() and "/" not in spec and (rulebooks_dir() / spec).is_dir():
-        path = rulebooks_dir() / spec
+    path = rulebook_path(spec)
     if not path.is_dir():
         raise InputError("--rulebook", f"{spec!r} is neither a shipped rulebook nor a directory")
     return load_rulebook(path)

@@ -67,3 +67,17 @@ def test_replay_diff_and_budget_check_plan_the_any_arm_rulebook(tmp_path):
     expected = [plan_scenario(load_scenario(path), "fuzzy-rrt-connect", rulebook=rb, seed=k)
                 for k in range(2)]
     assert list(runs["iterations"]) == [r.iterations for r in expected]
+
+
+def test_evaluate_runs_the_any_arm_rulebook_with_connect(tmp_path):
+    """``evaluate --rulebook goal-frame-any`` was refused the same way; it now ranks
+    ``fuzzy-rrt-connect:goal-frame-any``."""
+    import pandas as pd
+
+    path = _scenario(tmp_path)
+    proc = run_main("evaluate", path, "--rulebook", "goal-frame-any", "--runs", "2",
+                    "--caches", "warm", "--out", tmp_path / "ev")
+    assert proc.returncode == 0, proc.stderr
+    runs = pd.read_csv(tmp_path / "ev" / "runs.csv")
+    mine = runs[runs["planner"] == "fuzzy-rrt-connect:goal-frame-any"]
+    assert len(mine) == 2 and set(mine["planner_used"]) == {"fuzzy-rrt-connect"}

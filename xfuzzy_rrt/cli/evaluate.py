@@ -70,9 +70,13 @@ def evaluate(
     entries = []
     if tuned and "rrt:tuned" not in peer:
         entries.append((check_planner("rrt:tuned", "--tuned"), "rrt:tuned", None))
+    from xfuzzy_rrt.planners.api import planner_of_rulebook
+
     for spec in rulebook:
         rb = _rulebook(spec)
-        entries.append((f"fuzzy-rrt:{rb.name}", "fuzzy-rrt", rb))
+        # a DOF-free rulebook (goal-frame-any) with the planner that reads it, Fuzzy-RRT-Connect
+        kind = planner_of_rulebook(rb)
+        entries.append((f"{kind}:{rb.name}", kind, rb))
     for p in peer:
         entries.append((check_planner(p, "--peer"), p, None))
     labels = [e[0] for e in entries]

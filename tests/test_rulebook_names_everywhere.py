@@ -53,3 +53,11 @@ def test_a_name_that_is_neither_is_still_one_error_line(tmp_path):
     assert proc.stderr.strip() == "error: no-such-rulebook: rulebook directory does not exist"
     # a path-like argument is never looked up among the shipped ones
     assert str(rulebook_path("./goal-frame")) == "goal-frame"
+
+
+def test_a_typo_of_a_shipped_name_says_which_one_was_meant(tmp_path):
+    proc = run_main("rules", "show", "goal-fram", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == ("error: goal-fram: rulebook directory does not exist (did you "
+                                   "mean the shipped 'goal-frame'?)")
+    assert not (tmp_path / "goal-fram").exists()

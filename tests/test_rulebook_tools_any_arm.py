@@ -13,7 +13,7 @@ from xfuzzy_rrt.analysis.coverage import collect_counts
 from xfuzzy_rrt.analysis.simplify import measure_runs
 from xfuzzy_rrt.fuzzy.rulebook import load_rulebook, rulebooks_dir
 from xfuzzy_rrt.geometry.scenario import load_scenario
-from xfuzzy_rrt.planners.api import plan_scenario, planner_of_rulebook
+from xfuzzy_rrt.planners.api import plan_scenario
 
 THREE_JOINTS = """name = "three-joints"
 [arm]
@@ -37,10 +37,10 @@ def _scenario(tmp_path):
 
 
 def test_each_rulebook_is_planned_with_the_planner_that_reads_it():
-    assert planner_of_rulebook(load_rulebook(rulebooks_dir() / "goal-frame-any")) == \
+    assert load_rulebook(rulebooks_dir() / "goal-frame-any").semantics.planner == \
         "fuzzy-rrt-connect"
     for name in ("goal-frame", "paper", "expert"):
-        assert planner_of_rulebook(load_rulebook(rulebooks_dir() / name)) == "fuzzy-rrt"
+        assert load_rulebook(rulebooks_dir() / name).semantics.planner == "fuzzy-rrt"
 
 
 def test_coverage_of_the_any_arm_rulebook_counts_connect_runs(tmp_path):

@@ -115,10 +115,11 @@ def counts_from_trace(trace: pd.DataFrame, success: bool | None = None) -> Cover
 
 
 def _one(args) -> CoverageCounts:
-    from xfuzzy_rrt.planners.api import plan_scenario, planner_of_rulebook
+    from xfuzzy_rrt.planners.api import plan_scenario
 
     scenario, rulebook, seed, max_iter = args
-    res = plan_scenario(scenario, planner=planner_of_rulebook(rulebook), rulebook=rulebook,
+    # the planner the rulebook's semantics names (goal-frame-any: Fuzzy-RRT-Connect)
+    res = plan_scenario(scenario, planner=rulebook.semantics.planner, rulebook=rulebook,
                         seed=seed, max_iter=max_iter, trace=True)
     return counts_from_trace(res.trace, success=res.success)
 

@@ -245,11 +245,12 @@ def _fired(trace: pd.DataFrame, row: int, out: str) -> dict[int, float]:
 
 def replay_diff(scenario, a, b, seed: int = 0, max_iter: int = 10_000) -> ReplayDiff:
     """Plan *scenario* with seed *seed* under rulebooks *a* and *b* and explain the divergence."""
-    from xfuzzy_rrt.planners.api import plan_scenario, planner_of_rulebook
+    from xfuzzy_rrt.planners.api import plan_scenario
 
-    ra = plan_scenario(scenario, planner_of_rulebook(a), rulebook=a, seed=seed,
+    # each with the planner its semantics names (goal-frame-any: Fuzzy-RRT-Connect)
+    ra = plan_scenario(scenario, a.semantics.planner, rulebook=a, seed=seed,
                        max_iter=max_iter, trace=True)
-    rb = plan_scenario(scenario, planner_of_rulebook(b), rulebook=b, seed=seed,
+    rb = plan_scenario(scenario, b.semantics.planner, rulebook=b, seed=seed,
                        max_iter=max_iter, trace=True)
     ta, tb = ra.trace, rb.trace
     it = first_divergence(ta, tb)

@@ -182,10 +182,10 @@ def with_consts(rulebook, consts, name: str, provenance: dict):
 
 
 def _plan_iterations(args) -> tuple[int, bool]:
-    from xfuzzy_rrt.planners.api import plan_scenario, planner_of_rulebook
+    from xfuzzy_rrt.planners.api import plan_scenario
 
     scenario, rulebook, seed, max_iter = args
-    r = plan_scenario(scenario, planner=planner_of_rulebook(rulebook), rulebook=rulebook,
+    r = plan_scenario(scenario, planner=rulebook.semantics.planner, rulebook=rulebook,
                       seed=seed, max_iter=max_iter)
     return r.iterations, r.success
 

@@ -70,12 +70,10 @@ def evaluate(
     entries = []
     if tuned and "rrt:tuned" not in peer:
         entries.append((check_planner("rrt:tuned", "--tuned"), "rrt:tuned", None))
-    from xfuzzy_rrt.planners.api import planner_of_rulebook
-
     for spec in rulebook:
         rb = _rulebook(spec)
-        # a DOF-free rulebook (goal-frame-any) with the planner that reads it, Fuzzy-RRT-Connect
-        kind = planner_of_rulebook(rb)
+        # with the planner its semantics names (goal-frame-any: Fuzzy-RRT-Connect)
+        kind = rb.semantics.planner
         entries.append((f"{kind}:{rb.name}", kind, rb))
     for p in peer:
         entries.append((check_planner(p, "--peer"), p, None))

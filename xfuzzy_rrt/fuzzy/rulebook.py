@@ -325,10 +325,27 @@ def rulebook_path(spec: str | os.PathLike[str]) -> Path:
     current directory still wins (it is what the path names)."""
     path = Path(spec)
     text = os.fspath(spec)
-    if path.exists() or "/" in text or "\\" in text or text.startswith((".", "~")) or not text:
+    if path.exists() or not _bare_name(text):
         return path
     shipped = rulebooks_dir() / text
     return shipped if shipped.is_dir() else path
+
+
+def _bare_name(text: str) -> bool:
+    """A word that can name a shipped rulebook: no path separator, not ``.``/``~``-led."""
+    return bool(text) and "/" not in text and "\\" not in text and not text.startswith((".", "~"))
+
+
+def _shipped_hint(text: str) -> str:
+    """`` (did you mean the shipped 'goal-frame'?)`` for a bare word close to a shipped
+    rulebook's name (a typo of one, :func:`rulebook_path` having found no such folder), else
+    ``""``."""
+    if not _bare_name(text):
+        return ""
+    import difflib
+
+    close = difflib.get_close_matches(text, [p.name for p in list_rulebooks()], n=1, cutoff=0.8)
+    return f" (did you mean the shipped {close[0]!r}?)" if close else ""
 
 
 @functools.cache
@@ -563,7 +580,8 @@ def load_rulebook(path: str | os.PathLike[str]) -> Rulebook:
     """
     root = Path(path)
     if not root.exists():
-        raise RulebookError([(str(root), None, "rulebook directory does not exist")])
+        raise RulebookError([(str(root), None, "rulebook directory does not exist"
+                              + _shipped_hint(os.fspath(path)))])
     if not root.is_dir():
         raise RulebookError([(str(root), None, "not a directory (a rulebook is a directory)")])
     problems: list[tuple[str, int | None, str]] = []

@@ -180,16 +180,6 @@ def load_shipped_default() -> ShippedDefault:
                           load_rulebook(default_rulebook_dir(ANY_ARM_PLANNER)))
 
 
-def planner_of_rulebook(rulebook) -> str:
-    """The planner a loaded rulebook plans with when a tool plans with it on its own (``rules
-    coverage``, ``rules diff --replay``, ``rules simplify --budget``): Fuzzy-RRT-Connect for a
-    DOF-free rulebook (``goal-frame-any``: the only planner that reads it), else plain
-    ``fuzzy-rrt``. Why: those tools named ``fuzzy-rrt`` whatever the rulebook, so the rulebook
-    the default plans every problem but one 2-joint arm with could not be covered, replayed or
-    simplified against a budget (one error line: 'plans with --planner fuzzy-rrt-connect')."""
-    return ANY_ARM_PLANNER if rulebook.semantics.dof_free else "fuzzy-rrt"
-
-
 def shipped_rulebook_names() -> list[str]:
     from xfuzzy_rrt.fuzzy.rulebook import list_rulebooks
 

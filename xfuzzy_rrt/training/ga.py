@@ -130,24 +130,14 @@ class GAConfig:
             what = "RRT's median iterations" if self.fitness == "log-ratio" else "the tuned RRT's median work"
             need(len(self.baseline) == len(self.scenarios), "--fitness",
                  f"{self.fitness} needs {what} for every training scenario")
-            bad = next((i for i, b in enumerate(self.baseline) if not b > 0), None)
-            # a start that is its goal needs no iteration: nothing to learn from, nothing to
-            # divide by
-            need(bad is None, "--fitness",
-                 f"{self.fitness} needs {what} (positive) for every training scenario; "
-                 f"{_name(self.scenarios, bad)} has {self.baseline[bad] if bad is not None else 0:g}"
-                 " (is its start its goal?)")
+            _refuse_nonpositive(self.baseline, self.scenarios, self.fitness, what)
             need(len(self.validation_baseline) == len(self.validation), "--validation-scenario",
                  f"{self.fitness} needs {what} for every validation scenario")
         if self.fitness == "work-cost-cvar":
             what = "the tuned RRT's median path cost"
-            bad = next((i for i, b in enumerate(self.baseline_cost)
-                        if not (np.isfinite(b) and b > 0)), None)
-            need(len(self.baseline_cost) == len(self.scenarios) and bad is None,
-                 "--fitness", f"work-cost-cvar needs {what} (positive) for every training "
-                 f"scenario" + (f"; {_name(self.scenarios, bad)} has "
-                                f"{self.baseline_cost[bad]:g} (is its start its goal?)"
-                                if bad is not None else ""))
+            need(len(self.baseline_cost) == len(self.scenarios), "--fitness",
+                 f"work-cost-cvar needs {what} for every training scenario")
+            _refuse_nonpositive(self.baseline_cost, self.scenarios, self.fitness, what)
             need(len(self.validation_baseline_cost) == len(self.validation)
                  and all(np.isfinite(b) and b > 0 for b in self.validation_baseline_cost),
                  "--validation-scenario",
@@ -198,12 +188,18 @@ class GAConfig:
 # ------------------------------------------------------------------------------ seeds
 
 
-def _name(scenarios, i) -> str:
-    """``scenario 'NAME'`` for training scenario ``i`` (``scenarios``: ``(name, sha256)`` pairs),
-    as the one-line refusals above name it; its index when the names are not recorded."""
-    if i is None:
-        return "a scenario"
-    return f"scenario {scenarios[i][0]!r}" if i < len(scenarios) else f"scenario {i + 1}"
+def _refuse_nonpositive(baseline, scenarios, fitness: str, what: str) -> None:
+    """One InputError naming the first training scenario whose baseline (``what``, per
+    scenario) is not a positive number: the fitness divides by it. A start that is its goal
+    needs no iteration and has a path of length zero (``scenarios``: ``(name, sha256)`` pairs;
+    its position when the names are not recorded)."""
+    from xfuzzy_rrt.errors import InputError
+
+    for i, b in enumerate(baseline):
+        if not b > 0:  # (NaN too: no path found)
+            name = f"scenario {scenarios[i][0]!r}" if i < len(scenarios) else f"scenario {i + 1}"
+            raise InputError("--fitness", f"{fitness} needs {what} (positive) for every "
+                             f"training scenario; {name} has {b:g} (is its start its goal?)")
 
 
 def check_fitness_fits(fitness: str, bounds: str) -> None:

@@ -9,10 +9,11 @@ of the normal run, because nothing else notices a file missing from the wheel.
 Compiling every kernel again in the fresh site-packages took 8 of the suite's minutes on two
 busy cores and proves nothing about packaging (numba keys its cache on a hash of each source
 file's bytes, so the checkout's cache is valid for the byte-identical installed copy). So the
-installed copy starts from the checkout's numba cache, minus the entries of ``finish_tree_run``
-(a small kernel ``plan`` calls from Python): the first ``plan`` still compiles in the fresh
-site-packages, must say so on exactly one line and must leave that kernel cached there for
-the next command. Kernels the checkout has not compiled yet are simply compiled by the
+installed copy starts from the checkout's numba cache, minus the entries of the goal-frame
+planner's entry (``goal_frame_entry``, which ``plan`` calls from Python; its kernel and every
+other callee load from the seeded cache, so only the entry itself compiles): the first
+``plan`` still compiles in the fresh site-packages, must say so on exactly one line and must
+leave that kernel cached there for the next command. Kernels the checkout has not compiled yet are simply compiled by the
 installed copy (slower, same checks).
 """
 
@@ -96,7 +97,7 @@ def installed(wheel, tmp_path_factory) -> Path:
 
 
 #: Cache entries left out of the seed, so that the installed copy's first ``plan`` compiles.
-UNSEEDED = "result.finish_tree_run-"
+UNSEEDED = "fuzzy_rrt.goal_frame_entry-"
 
 
 def _seed_numba_cache(package: Path) -> None:

@@ -98,7 +98,7 @@ from xfuzzy_rrt.planners.result import (
 from xfuzzy_rrt.planners.rng import seed_state
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
-from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
+from xfuzzy_rrt.geometry.problem import Problem, counting_problem
 from xfuzzy_rrt.planners.prepared import pooled_trees, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import set_up
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
@@ -384,19 +384,21 @@ def finish_connect_run(nodes_a, parent_a, na, nodes_b, parent_b, nb_, last_a, la
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots, consts, scale,
-                  min_step, stop, tr, grown, connect_nodes):
-    """:func:`connect_kernel` with the problem and trace bundles as *plain* tuples and the two
-    trees as their arenas, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the
-    goal tree's view of the problem is built in the kernel's loop (:func:`reversed_problem`),
-    not unboxed a second time. Returns the kernel's four values and the number of extensions
-    attempted.
+def connect_entry(head, block_a, layout_a, block_b, layout_b, seed, max_iter, knots, consts,
+                  scale, min_step, stop, tr, grown, connect_nodes):
+    """:func:`connect_kernel` with the problem's head and the trace bundle as *plain* tuples
+    and the two trees as their arenas, emptied here (see
+    :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the goal tree's view of the problem is built in
+    the kernel's loop (:func:`reversed_problem`), not unboxed a second time. Returns the run
+    finished, in one call: the kernel's four values, the number of extensions attempted, both
+    trees' sizes, :func:`finish_connect_run`'s six values (no path when the run failed) and
+    the run's work (``P.work[0]`` and both trees' nearest-neighbour visits).
 
     ``tr`` ``None`` (a run that records nothing; ``grown`` and ``connect_nodes`` are then
     ``None`` too): the kernel compiled without trace code runs, and no trace array is unboxed
     (an untraced call passed 16 idle arrays until the eleventh session, ~12 us of a 3-joint
     call with cold caches; docs/peer-measurements.md)."""
-    P = Problem(*p)
+    P = counting_problem(head)
     TA = emptied_tree_in(block_a, layout_a)
     TB = emptied_tree_in(block_b, layout_b)
     counts = np.zeros(1, dtype=np.int64)
@@ -407,7 +409,14 @@ def connect_entry(p, block_a, layout_a, block_b, layout_b, seed, max_iter, knots
         ok, it, last_a, last_b = connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale,
                                                 min_step, stop, TraceArrays(*tr), grown,
                                                 connect_nodes, counts)
-    return ok, it, last_a, last_b, counts[0]
+    na = TA.meta[0]
+    nb_ = TB.meta[0]
+    nodes, parent, path, cost, within, same = finish_connect_run(
+        TA.nodes, TA.parent, na, TB.nodes, TB.parent, nb_, last_a if ok else -1, last_b,
+        P.limits)
+    work = P.work[0] + TA.meta[NN_VISITS] + TB.meta[NN_VISITS]
+    return (ok, it, last_a, last_b, counts[0], na, nb_, nodes, parent, path, cost, within, same,
+            work)
 
 
 class _Setup(NamedTuple):
@@ -475,10 +484,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         setup = _setup_for(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m)
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
-    work = new_work_counter()  # one count for both directions
-    problem = (*setup.forward_head, work)
     arena_a, arena_b = pooled_trees(setup.capacity, a.limits_deg, 2, a.stop_width)
-    ta, tb = arena_a.tree, arena_b.tree
     if trace:
         buffers = make_trace(max_iter, a.dof, knots.shape[0], 1)
         grown = np.zeros(max_iter, dtype=np.int8)
@@ -486,30 +492,27 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         tr = tuple(buffers)
     else:  # no trace: the kernel compiled without trace code runs
         tr = grown = connect_nodes = None
-    args = (problem, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout, int(seed))
+    args = (setup.forward_head, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout,
+            int(seed))
     recorded = dict(setup.recorded)
     if max_time_s is None:  # the entry called here, not through a helper (one Python call less)
         t0 = time.perf_counter()
-        ok, iterations, last_a, last_b, extensions = connect_entry(
-            *args, max_iter, knots, consts, scale, min_step, NEVER_STOPPED, tr, grown,
-            connect_nodes)
+        (ok, iterations, last_a, last_b, extensions, na, nb_, nodes, parent, path, cost, within,
+         same, work) = connect_entry(*args, max_iter, knots, consts, scale, min_step,
+                                     NEVER_STOPPED, tr, grown, connect_nodes)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        # (the next run empties the trees again)
+        # (the next run empties the trees again and counts its own work)
         connect_entry(*args, 0, knots, consts, scale, min_step, np.zeros(1, dtype=np.int64), tr,
                       grown, connect_nodes)
-        work[0] = 0
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
-            ok, iterations, last_a, last_b, extensions = connect_entry(
-                *args, max_iter, knots, consts, scale, min_step, flag.array, tr, grown,
-                connect_nodes)
+            (ok, iterations, last_a, last_b, extensions, na, nb_, nodes, parent, path, cost,
+             within, same, work) = connect_entry(*args, max_iter, knots, consts, scale, min_step,
+                                                 flag.array, tr, grown, connect_nodes)
             wall = time.perf_counter() - t0
     ok = bool(ok)
-    na, nb_ = int(ta.meta[0]), int(tb.meta[0])
-    nodes, parent, path, cost, within, same = finish_connect_run(
-        ta.nodes, ta.parent, na, tb.nodes, tb.parent, nb_, int(last_a) if ok else -1,
-        int(last_b), a.limits_deg)
+    na, nb_ = int(na), int(nb_)
     if not same:
         raise RuntimeError("fuzzy-rrt-connect: the two trees' junction nodes differ")
     recorded.update(extensions=int(extensions), start_tree_nodes=na, goal_tree_nodes=nb_)
@@ -523,7 +526,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         cost_deg=cost if ok else None, wall_s=wall, path_deg=path,
         tree_nodes_deg=nodes, tree_parent=parent, rulebook=rb.name,
         rulebook_sha256=rb.sha256, params=recorded,
-        work=int(work[0] + ta.meta[NN_VISITS] + tb.meta[NN_VISITS]),
+        work=int(work),
         # every path segment is a tree edge the kernel certified with edge_free at this margin
         # (the goal tree's, traversed backwards: the same set of configurations)
         edges_certified=True, within_limits=within,

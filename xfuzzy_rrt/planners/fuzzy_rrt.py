@@ -60,14 +60,14 @@ from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_str, load_rulebook_cached
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.collision import direction_and_distance, nearest_obstacle_for_arm
 from xfuzzy_rrt.geometry.kinematics import arm_end_effector
-from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
+from xfuzzy_rrt.geometry.problem import counting_problem
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.params import default
 from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
-                                         finish_tree_run, replace_result)
+                                         finished_tree, replace_result)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import (
@@ -77,7 +77,7 @@ from xfuzzy_rrt.planners.trace_record import (
 )
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import set_up
-from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
+from xfuzzy_rrt.planners.tree import add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
 #: Smallest step (degrees) the planner takes whatever the rulebook says.
@@ -275,29 +275,36 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def fuzzy_rrt_entry(p, block, layout, seed, max_iter, knots, consts, bounds_mode, min_step,
+def fuzzy_rrt_entry(head, block, layout, seed, max_iter, knots, consts, bounds_mode, min_step,
                     stop, tr):
-    """:func:`fuzzy_rrt_kernel` with the problem and trace bundles as *plain* tuples and the
-    tree as its arena, emptied here (see :func:`xfuzzy_rrt.planners.rrt.rrt_entry`). ``tr``
+    """:func:`fuzzy_rrt_kernel` with the problem's head and the trace bundle as *plain* tuples
+    and the tree as its arena, emptied here; returns the run finished (see
+    :func:`xfuzzy_rrt.planners.rrt.rrt_entry`: what a semantics' kernel entry returns). ``tr``
     ``None``: a run that records nothing, through the kernel compiled without trace code."""
-    P = Problem(*p)
+    P = counting_problem(head)
+    T = emptied_tree_in(block, layout)
     if tr is None:  # decided when compiled: the branch not taken is not compiled at all
-        return fuzzy_rrt_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots,
-                                consts, bounds_mode, min_step, stop, None)
-    return fuzzy_rrt_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots, consts,
-                            bounds_mode, min_step, stop, TraceArrays(*tr))
+        ok, it, last = fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode,
+                                        min_step, stop, None)
+    else:
+        ok, it, last = fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode,
+                                        min_step, stop, TraceArrays(*tr))
+    return finished_tree(P, T, ok, it, last)
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def goal_frame_entry(p, block, layout, seed, max_iter, knots, consts, mode, min_step, stop,
+def goal_frame_entry(head, block, layout, seed, max_iter, knots, consts, mode, min_step, stop,
                      tr):
     """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, called as above."""
-    P = Problem(*p)
+    P = counting_problem(head)
+    T = emptied_tree_in(block, layout)
     if tr is None:  # decided when compiled, as above
-        return goal_frame_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots,
-                                 consts, mode, min_step, stop, None)
-    return goal_frame_kernel(P, emptied_tree_in(block, layout), seed, max_iter, knots, consts,
-                             mode, min_step, stop, TraceArrays(*tr))
+        ok, it, last = goal_frame_kernel(P, T, seed, max_iter, knots, consts, mode, min_step,
+                                         stop, None)
+    else:
+        ok, it, last = goal_frame_kernel(P, T, seed, max_iter, knots, consts, mode, min_step,
+                                         stop, TraceArrays(*tr))
+    return finished_tree(P, T, ok, it, last)
 
 
 def entry_for(mode: int):
@@ -398,44 +405,41 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
         setup = _setup_for(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m)
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, mode, kernel = setup.knots, setup.consts, setup.mode, setup.kernel
-    problem = (*setup.problem_head, new_work_counter())
+    head = setup.problem_head
     arena = pooled_tree(max_iter + 2, a.limits_deg, a.stop_width)
-    tree, block, layout = arena.tree, arena.block, arena.layout
+    block, layout = arena.block, arena.layout
     # untraced: None, and the kernel compiled without trace code runs
     buffers = tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace else None
     recorded = dict(setup.recorded)
     if max_time_s is None:
         t0 = time.perf_counter()
-        ok, iterations, last = kernel(problem, block, layout, int(seed), max_iter, knots,
-                                      consts, mode, setup.min_step, NEVER_STOPPED, buffers)
+        ok, iterations, last, n, nodes, parents, path, cost, within, work = kernel(
+            head, block, layout, int(seed), max_iter, knots, consts, mode, setup.min_step,
+            NEVER_STOPPED, buffers)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        kernel(problem, block, layout, int(seed), 0, knots, consts, mode, setup.min_step,
+        kernel(head, block, layout, int(seed), 0, knots, consts, mode, setup.min_step,
                np.zeros(1, dtype=np.int64), buffers)
-        problem[-1][0] = 0
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
-            ok, iterations, last = kernel(problem, block, layout, int(seed), max_iter, knots,
-                                          consts, mode, setup.min_step, flag.array, buffers)
+            ok, iterations, last, n, nodes, parents, path, cost, within, work = kernel(
+                head, block, layout, int(seed), max_iter, knots, consts, mode, setup.min_step,
+                flag.array, buffers)
             wall = time.perf_counter() - t0
         recorded["max_time_s"] = float(setup.params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
-    n = int(tree.meta[0])
-    nodes, parents, path, cost, within = finish_tree_run(tree.nodes, tree.parent, n,
-                                                         last if ok else -1, a.limits_deg)
     # certifies the path (found -> success)
     result = certified_result(
         a, margin, bool(ok), edges_certified=True, within_limits=within,
         scenario=scenario.name, planner=label, planner_used="fuzzy-rrt", seed=int(seed),
-        iterations=int(iterations), nodes=n, cost_deg=cost if ok else None, wall_s=wall,
-        path_deg=path, tree_nodes_deg=nodes, tree_parent=parents,
-        work=int(problem[-1][0] + tree.meta[NN_VISITS]),
+        iterations=int(iterations), nodes=int(n), cost_deg=cost if ok else None, wall_s=wall,
+        path_deg=path, tree_nodes_deg=nodes, tree_parent=parents, work=int(work),
         rulebook=rb.name, rulebook_sha256=rb.sha256, params=recorded,
     )
     if trace:
         from xfuzzy_rrt.planners.trace import trace_frame
 
-        frame = trace_frame(TraceArrays(*buffers), int(iterations), tree.nodes[:n],
-                            tree.parent[:n], last, rb, setup.min_step, setup.groups)
+        frame = trace_frame(TraceArrays(*buffers), int(iterations), nodes, parents, last, rb,
+                            setup.min_step, setup.groups)
         result = replace_result(result, trace=frame)
     return result

@@ -40,6 +40,8 @@ from typing import Any
 import numba as nb
 import numpy as np
 
+from xfuzzy_rrt.planners.tree import NN_VISITS
+
 #: Per-iteration outcome codes, shared by planners and traces.
 ACCEPTED = 0
 NODE_IN_COLLISION = 1
@@ -171,6 +173,23 @@ def finish_tree_run(nodes, parent, n, last, limits):
     path = branch_path(nodes, parent, last)
     within = path.shape[0] > 0 and vertices_within(path, limits)
     return tree_nodes, tree_parent, path, path_cost_compiled(path), within
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def finished_tree(P, T, ok, iterations, last):
+    """A tree kernel's run as its compiled entry returns it: ``(ok, iterations, last, n,
+    nodes, parents, path, cost, within, work)`` -- the kernel's three values, the tree's size,
+    :func:`finish_tree_run` of the tree (no path when the run failed), and the run's work
+    (``P.work[0]`` plus the tree's nearest-neighbour visits).
+
+    Why in the entry: a second compiled call from Python to finish the run, and reading the
+    counters from Python, cost 40-60 us of a call that starts with cold caches (numba unboxes
+    every argument again; docs/peer-measurements.md, twenty-second session)."""
+    n = T.meta[0]
+    nodes, parents, path, cost, within = finish_tree_run(T.nodes, T.parent, n,
+                                                         last if ok else -1, P.limits)
+    return (ok, iterations, last, n, nodes, parents, path, cost, within,
+            P.work[0] + T.meta[NN_VISITS])
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)

@@ -17,18 +17,17 @@ from typing import Any, NamedTuple
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.geometry.problem import Problem, new_work_counter
+from xfuzzy_rrt.geometry.problem import counting_problem
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.params import default
-from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
-                                         finish_tree_run)
+from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, finished_tree
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import set_up
-from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
+from xfuzzy_rrt.planners.tree import add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
 
 DEFAULT_STEP_DEG = default("rrt", "step_deg")
@@ -73,17 +72,22 @@ def _rrt_loop(P, T, seed, max_iter, step, goal_bias, stop, state, sample, q_near
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def rrt_entry(p, block, layout, seed, max_iter, step, goal_bias, stop):
-    """:func:`rrt_kernel` called with the problem as a *plain* tuple and the tree as its
-    arena (:mod:`~xfuzzy_rrt.planners.tree_arena`), emptied here.
+def rrt_entry(head, block, layout, seed, max_iter, step, goal_bias, stop):
+    """:func:`rrt_kernel` called with the problem's ``head`` as a *plain* tuple (its work
+    counter is made here: :func:`~xfuzzy_rrt.geometry.problem.counting_problem`) and the tree
+    as its arena (:mod:`~xfuzzy_rrt.planners.tree_arena`), emptied here; returns the run
+    finished (:func:`~xfuzzy_rrt.planners.result.finished_tree`: the kernel's three values,
+    the tree's size, its copies, the path, its cost, the limits re-check and the work).
 
     Why: numba types a named-tuple argument in Python, element by element, on every call
     (20-40 us for our two bundles, as much as a short 2-DOF plan); a plain tuple of arrays is
     typed by its fast C path, and one block instead of the tree's 17 arrays is unboxed once.
     The bundles are rebuilt here, inside compiled code, for free.
     """
-    return rrt_kernel(Problem(*p), emptied_tree_in(block, layout), seed, max_iter, step,
-                      goal_bias, stop)
+    P = counting_problem(head)
+    T = emptied_tree_in(block, layout)
+    ok, it, last = rrt_kernel(P, T, seed, max_iter, step, goal_bias, stop)
+    return finished_tree(P, T, ok, it, last)
 
 
 class _Setup(NamedTuple):
@@ -145,34 +149,29 @@ def plan_rrt_as(label: str, extra_params: dict | None, scenario: Scenario, seed:
                          max_time_s)
     a, margin, params = setup.arrays, setup.margin, setup.params
     max_iter = int(params["max_iter"])
-    problem = (*setup.problem_head, new_work_counter())
+    head = setup.problem_head
     arena = pooled_tree(max_iter + 2, a.limits_deg, a.stop_width)
-    tree, block, layout = arena.tree, arena.block, arena.layout
+    block, layout = arena.block, arena.layout
     step, bias = float(params["step_deg"]), float(params["goal_bias"])
     recorded = dict(setup.recorded)
     if max_time_s is None:
         t0 = time.perf_counter()
-        ok, iterations, last = rrt_entry(problem, block, layout, int(seed), max_iter, step, bias,
-                                         NEVER_STOPPED)
+        ok, iterations, _, n, nodes, parents, path, cost, within, work = rrt_entry(
+            head, block, layout, int(seed), max_iter, step, bias, NEVER_STOPPED)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        rrt_entry(problem, block, layout, int(seed), 0, step, bias, np.zeros(1, dtype=np.int64))
-        problem[-1][0] = 0
+        rrt_entry(head, block, layout, int(seed), 0, step, bias, np.zeros(1, dtype=np.int64))
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
-            ok, iterations, last = rrt_entry(problem, block, layout, int(seed), max_iter, step,
-                                             bias, flag.array)
+            ok, iterations, _, n, nodes, parents, path, cost, within, work = rrt_entry(
+                head, block, layout, int(seed), max_iter, step, bias, flag.array)
             wall = time.perf_counter() - t0
         recorded["max_time_s"] = float(params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
-    n = int(tree.meta[0])
-    nodes, parents, path, cost, within = finish_tree_run(tree.nodes, tree.parent, n,
-                                                         last if ok else -1, a.limits_deg)
     return certified_result(
         a, margin, bool(ok), edges_certified=True, within_limits=within,
         scenario=scenario.name, planner=label, planner_used=label, seed=int(seed),
-        iterations=int(iterations), nodes=n, cost_deg=cost if ok else None, wall_s=wall,
-        path_deg=path, tree_nodes_deg=nodes, tree_parent=parents,
-        work=int(problem[-1][0] + tree.meta[NN_VISITS]),
+        iterations=int(iterations), nodes=int(n), cost_deg=cost if ok else None, wall_s=wall,
+        path_deg=path, tree_nodes_deg=nodes, tree_parent=parents, work=int(work),
         params=recorded if extra_params is None else {**recorded, **extra_params},
     )

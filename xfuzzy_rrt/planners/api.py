@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import functools
 import os
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -295,17 +297,78 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     ``max_time_s``: a wall-clock budget on top of ``max_iter`` (whichever ends first;
     :mod:`xfuzzy_rrt.planners.termination`).
     Every planner goes through its registration's ``plan`` (:mod:`.registry`): one dict
-    look-up, no chain of names.
+    look-up, no chain of names. A call that repeats an earlier one's very objects (see
+    :data:`_LANES`) goes straight to the run its registration's ``bind`` made then.
     """
+    if not trace and max_time_s is None:
+        lane = _LANES.get((planner, id(scenario)))
+        if lane is not None and lane[0]() is scenario and lane[1] is rulebook and \
+                lane[2] is max_iter and lane[3] is step_deg and lane[4] is goal_bias and \
+                lane[5] is clearance_m:
+            return lane[6](check_seed(seed))
     check_seed(seed)
     spec = parse_planner(planner, "--planner", recheck=False)
     entry = spec.planner
     if trace and not entry.traces:
         raise InputError("--trace", "traces record fuzzy decisions; use --planner "
                          f"{_registry.either(_registry.exact_labels(traces=True))}")
+    if not trace and max_time_s is None and entry.bind is not None:
+        run = entry.bind_fn(scenario, spec, rulebook, max_iter=max_iter, step_deg=step_deg,
+                            goal_bias=goal_bias, clearance_m=clearance_m)
+        if run is not None:
+            _keep_lane((planner, id(scenario)), scenario,
+                       (rulebook, max_iter, step_deg, goal_bias, clearance_m, run))
+            return run(seed)
     return entry.plan_fn(scenario, spec, rulebook, seed=seed, max_iter=max_iter,
                          step_deg=step_deg, goal_bias=goal_bias, trace=trace,
                          clearance_m=clearance_m, max_time_s=max_time_s)
+
+
+#: ``(label, id(scenario))`` -> ``(weak reference to the scenario, rulebook, max_iter,
+#: step_deg, goal_bias, clearance_m, run)``: the run (``run(seed) -> PlanResult``) that a
+#: registration's ``bind`` made for a call without a trace or a time budget, used again by a
+#: call that passes the very same objects (``is``, one by one, as
+#: :func:`~xfuzzy_rrt.planners.setup_memo.last_call` matches).
+#:
+#: Why: a loop of plans (``evaluate``, ``bench``, a library user's seeds) passes the same objects
+#: every time, and each call still went through the label's parse, its registration's ``plan``,
+#: the rulebook choice, the core's keyword call and the set-up memo: ~60-80 us of a call that
+#: starts with cold caches (a fifth of a 3-joint call) and ~3 us warm, the same for every planner
+#: (docs/peer-measurements.md, twenty-second session). A run is made only where nothing a later
+#: call could change is read again: a loaded rulebook, the preloaded shipped default or tuned
+#: settings, or a label that reads nothing (``rrt``); ``bind`` returns None otherwise (a rulebook
+#: given as a folder or ``None`` is resolved again on every call, so an edit is noticed), and
+#: the call takes the registration's ``plan``. An entry goes with its scenario (a weak
+#: reference whose callback drops it, so a recycled ``id`` never finds a dead scenario's run),
+#: and at most :data:`MAX_LANES` are kept, the oldest dropped.
+_LANES: dict = {}
+MAX_LANES = 1024
+
+
+def _keep_lane(key, scenario, lane) -> None:
+    try:
+        ref = weakref.ref(scenario, lambda r, k=key: _drop_lane(k, r))
+    except TypeError:  # not weak-referenceable: nothing is kept
+        return
+    _LANES.pop(key, None)
+    _LANES[key] = (ref, *lane)
+    while len(_LANES) > MAX_LANES:
+        try:
+            del _LANES[next(iter(_LANES))]
+        except (KeyError, StopIteration, RuntimeError):  # another thread trimmed it first
+            break
+
+
+def _drop_lane(key, ref) -> None:
+    """The scenario of ``key``'s run died: drop the entry if it is still that one's."""
+    lane = _LANES.get(key)
+    if lane is not None and lane[0] is ref:
+        _LANES.pop(key, None)
+
+
+def clear_lanes() -> None:
+    """Forget every kept run (tests; nothing else needs it)."""
+    _LANES.clear()
 
 
 # --- The built-in planners' hooks (registered in planners/registry.py) -------------------------
@@ -346,11 +409,58 @@ def plan_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max
 _TUNED_PARAMS = {"tuned": True}
 
 
+def bind_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, max_iter, step_deg,
+                   goal_bias, clearance_m):
+    """The run :func:`plan_rrt_label` makes of these arguments, for every seed (see
+    :data:`_LANES`): ``rrt`` with ``step_deg``/``goal_bias``, ``rrt:tuned`` with the settings a
+    caller read once (:class:`TunedRRT`); None for ``rrt:tuned`` without them (its file is
+    read on every call)."""
+    from xfuzzy_rrt.planners.rrt import bind_rrt_as
+
+    if spec.label == RRT_TUNED:
+        if type(rulebook) is not TunedRRT:
+            return None
+        return bind_rrt_as(RRT_TUNED, _TUNED_PARAMS, scenario, max_iter=max_iter,
+                           step_deg=rulebook.step_deg, goal_bias=rulebook.goal_bias,
+                           clearance_m=clearance_m)
+    return bind_rrt_as("rrt", None, scenario, max_iter=max_iter, step_deg=step_deg,
+                       goal_bias=goal_bias, clearance_m=clearance_m)
+
+
 def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter,
                         step_deg, goal_bias, trace, clearance_m, max_time_s) -> PlanResult:
     """``fuzzy-rrt[:RULEBOOK]`` and ``fuzzy-rrt-connect[:RULEBOOK]``: the rulebook the label or
     the caller names, else the shipped default (:func:`shipped_default`'s rule for plain
     ``fuzzy-rrt``); the kind that runs calls its registration's ``core``."""
+    core, rulebook = _rulebook_core(scenario, spec, rulebook)
+    # the core names its result with the label (planner_used: its own kind), as rrt:tuned's
+    # does: no finished result is copied to relabel it
+    return core.core_fn(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter, trace=trace,
+                        clearance_m=clearance_m, max_time_s=max_time_s, label=spec.label)
+
+
+def bind_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, max_iter, step_deg,
+                        goal_bias, clearance_m):
+    """The run :func:`plan_rulebook_label` makes of these arguments, for every seed (see
+    :data:`_LANES`), when the rulebook is one nothing can change: a loaded rulebook (for a
+    ``...:NAME|DIR`` label, one read from that very folder) or the preloaded
+    :class:`ShippedDefault`; else None."""
+    if isinstance(rulebook, ShippedDefault):
+        if spec.rulebook_dir is not None:
+            return None
+    elif not hasattr(rulebook, "compiled") or (
+            spec.rulebook_dir is not None and not _read_from(rulebook, spec.rulebook_dir)):
+        return None
+    core, rulebook = _rulebook_core(scenario, spec, rulebook)
+    if core.core_bind is None:
+        return None
+    return core.core_bind_fn(scenario, rulebook, max_iter=max_iter, clearance_m=clearance_m,
+                             label=spec.label)
+
+
+def _rulebook_core(scenario: Scenario, spec: PlannerSpec, rulebook):
+    """``(registration, rulebook)``: which rulebook planner runs a rulebook label's call and
+    with what (the label's rulebook, the caller's, or :func:`shipped_default`'s choice)."""
     kind = spec.kind
     if type(rulebook) is TunedRRT:
         raise InputError("--rulebook", f"tuned RRT settings are not a rulebook ({spec.label} "
@@ -373,11 +483,7 @@ def plan_rulebook_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed
             kind = "fuzzy-rrt" if scenario.one_two_joint_arm else ANY_ARM_PLANNER
     elif rulebook is None and default is not None:
         rulebook = default.any_arm
-    core = (spec.planner if kind == spec.kind else _registry.lookup(kind)).core_fn
-    # the core names its result with the label (planner_used: its own kind), as rrt:tuned's
-    # does: no finished result is copied to relabel it
-    return core(scenario, rulebook=rulebook, seed=seed, max_iter=max_iter, trace=trace,
-                clearance_m=clearance_m, max_time_s=max_time_s, label=spec.label)
+    return (spec.planner if kind == spec.kind else _registry.lookup(kind)), rulebook
 
 
 def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max_iter, step_deg,
@@ -389,6 +495,31 @@ def plan_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, ma
     return plan_ompl(scenario, spec.label, seed=seed, max_iter=max_iter, goal_bias=goal_bias,
                      clearance_m=clearance_m, time_limit_s=max_time_s,
                      tuned=rulebook if type(rulebook) is TunedRange else None)
+
+
+def bind_ompl_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, max_iter, step_deg,
+                    goal_bias, clearance_m):
+    """The run :func:`plan_ompl_label` makes of these arguments, for every seed (see
+    :data:`_LANES`), when its range needs nothing read: the label's own (``:range=DEG``) or the
+    tuned range a caller read once (:class:`~xfuzzy_rrt.planners.ompl_bridge.TunedRange`);
+    else None. The peers' calls skip what ours skip (fair comparisons): the label's parse and
+    the registration's ``plan``; every check of ``plan_ompl`` still runs in each call."""
+    from xfuzzy_rrt.planners.ompl_bridge import TunedRange, parse_ompl_label
+
+    tuned = rulebook if type(rulebook) is TunedRange else None
+    if tuned is None and parse_ompl_label(spec.label, "--planner").range_deg is None:
+        return None
+    # the scenario by weak reference: a kept run must not keep it alive (the run is used only
+    # by a call that passes this very scenario)
+    return functools.partial(_ompl_run, weakref.ref(scenario), spec.label, max_iter, goal_bias,
+                             clearance_m, tuned)
+
+
+def _ompl_run(scenario_ref, label, max_iter, goal_bias, clearance_m, tuned, seed) -> PlanResult:
+    from xfuzzy_rrt.planners.ompl_bridge import plan_ompl
+
+    return plan_ompl(scenario_ref(), label, seed=seed, max_iter=max_iter, goal_bias=goal_bias,
+                     clearance_m=clearance_m, time_limit_s=None, tuned=tuned)
 
 
 def _tuned_rrt(where: str) -> dict[str, float]:
@@ -422,13 +553,21 @@ def _same_rulebook(rulebook, directory: Path) -> bool:
     if rulebook is _PROVEN[0] and directory is _PROVEN[1]:
         return True
     if hasattr(rulebook, "sha256"):
-        from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached, loaded_from
+        from xfuzzy_rrt.fuzzy.rulebook import load_rulebook_cached
 
-        if loaded_from(rulebook) == os.path.abspath(directory):
+        if _read_from(rulebook, directory):
             _PROVEN[:] = (rulebook, directory)
             return True
         return rulebook.sha256 == load_rulebook_cached(directory).sha256
     return Path(rulebook).resolve() == Path(directory).resolve()
+
+
+def _read_from(rulebook, directory: Path) -> bool:
+    """A loaded rulebook :func:`~xfuzzy_rrt.fuzzy.rulebook.load_rulebook` read from
+    ``directory`` (the same absolute path; no file is touched)."""
+    from xfuzzy_rrt.fuzzy.rulebook import loaded_from
+
+    return loaded_from(rulebook) == os.path.abspath(directory)
 
 
 def write_trace_checked(path: Path) -> None:

@@ -64,6 +64,7 @@ other tree).
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from typing import Any, NamedTuple
@@ -482,6 +483,21 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
                          max_time_s)
     else:
         setup = _setup_for(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m)
+    return _run(setup, scenario.name, label, seed, trace, max_time_s)
+
+
+def bind_fuzzy_rrt_connect(scenario: Scenario, rulebook, *, max_iter, clearance_m, label):
+    """:func:`plan_fuzzy_rrt_connect` without a trace or a time budget, for every seed:
+    ``run(seed) -> PlanResult``, the same result (what ``plan_scenario`` keeps for a loop of
+    calls: ``api._LANES``)."""
+    return functools.partial(_run, _setup_for(scenario, rulebook, max_iter, None, None,
+                                              clearance_m), scenario.name, label)
+
+
+def _run(setup: _Setup, name: str, label: str, seed, trace=False,
+         max_time_s=None) -> PlanResult:
+    """One run of a checked set-up (:func:`plan_fuzzy_rrt_connect`) of the scenario
+    called ``name`` (the name, not the scenario: a kept run must not keep its scenario alive)."""
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
     arena_a, arena_b = pooled_trees(setup.capacity, a.limits_deg, 2, a.stop_width)
@@ -520,7 +536,7 @@ def plan_fuzzy_rrt_connect(scenario: Scenario, rulebook=None, seed: int = 0,
         recorded["max_time_s"] = float(setup.params["max_time_s"])
         recorded["stopped_by"] = stopped_by(ok, int(iterations), max_iter, flag)
     result = certified_result(
-        a, margin, ok, scenario=scenario.name, planner=label, planner_used=PLANNER,
+        a, margin, ok, scenario=name, planner=label, planner_used=PLANNER,
         seed=int(seed),
         iterations=int(iterations), nodes=na + nb_,
         cost_deg=cost if ok else None, wall_s=wall, path_deg=path,

@@ -48,6 +48,7 @@ Choices where the paper is silent or ambiguous (and why):
 
 from __future__ import annotations
 
+import functools
 import time
 from typing import Any, NamedTuple
 
@@ -403,6 +404,21 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
                          max_time_s)
     else:
         setup = _setup_for(scenario, rulebook, max_iter, min_step_deg, margin, clearance_m)
+    return _run(setup, scenario.name, label, seed, trace, max_time_s)
+
+
+def bind_fuzzy_rrt(scenario: Scenario, rulebook, *, max_iter, clearance_m, label):
+    """:func:`plan_fuzzy_rrt` without a trace or a time budget, for every seed: ``run(seed) ->
+    PlanResult``, the same result (what ``plan_scenario`` keeps for a loop of calls:
+    ``api._LANES``)."""
+    return functools.partial(_run, _setup_for(scenario, rulebook, max_iter, MIN_STEP_DEG, None,
+                                              clearance_m), scenario.name, label)
+
+
+def _run(setup: _Setup, name: str, label: str, seed, trace=False,
+         max_time_s=None) -> PlanResult:
+    """One run of a checked set-up (:func:`plan_fuzzy_rrt`) of the scenario
+    called ``name`` (the name, not the scenario: a kept run must not keep its scenario alive)."""
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, mode, kernel = setup.knots, setup.consts, setup.mode, setup.kernel
     head = setup.problem_head
@@ -431,7 +447,7 @@ def plan_fuzzy_rrt(scenario: Scenario, rulebook=None, seed: int = 0, max_iter: i
     # certifies the path (found -> success)
     result = certified_result(
         a, margin, bool(ok), edges_certified=True, within_limits=within,
-        scenario=scenario.name, planner=label, planner_used="fuzzy-rrt", seed=int(seed),
+        scenario=name, planner=label, planner_used="fuzzy-rrt", seed=int(seed),
         iterations=int(iterations), nodes=int(n), cost_deg=cost if ok else None, wall_s=wall,
         path_deg=path, tree_nodes_deg=nodes, tree_parent=parents, work=int(work),
         rulebook=rb.name, rulebook_sha256=rb.sha256, params=recorded,

@@ -68,6 +68,13 @@ class Planner:
     - ``plan_rechecks``: its ``plan`` repeats every check of its ``parse``, with the same one
       line, so ``plan_scenario`` runs only the plan's once the label was accepted (``rrt:tuned``
       reads its tuned file once a call, as the default reads its rulebook's stamps once).
+    - ``bind``: optional, ``bind(scenario, spec, rulebook, *, max_iter, step_deg, goal_bias,
+      clearance_m) -> run | None``: what ``plan`` would do for a call without a trace or a time
+      budget, as ``run(seed) -> PlanResult`` (the same result, bit for bit), which
+      ``plan_scenario`` keeps for calls that pass the very same objects again; None when a
+      later call must read something again (a file, a folder). ``None``: every call plans.
+    - ``core_bind``: for a rulebook planner, ``core_bind(scenario, rulebook, *, max_iter,
+      clearance_m, label) -> run``: ``core``'s run for every seed (what ``bind`` returns).
     """
 
     label: str
@@ -83,6 +90,8 @@ class Planner:
     fits: Callable[..., Any] | str | None = None
     help: str | None = field(default=None, compare=False)
     plan_rechecks: bool = False
+    bind: Callable[..., Any] | str | None = None
+    core_bind: Callable[..., Any] | str | None = None
 
     def __post_init__(self) -> None:
         if self.arg is None and self.label.endswith(":"):
@@ -114,6 +123,14 @@ class Planner:
     @cached_property
     def fits_fn(self):
         return _resolve(self.fits)
+
+    @cached_property
+    def bind_fn(self):
+        return _resolve(self.bind)
+
+    @cached_property
+    def core_bind_fn(self):
+        return _resolve(self.core_bind)
 
     def cli_name(self, label: str) -> str:
         """The ``plan --planner`` value that reruns *label* (of this form) with its rulebook
@@ -195,31 +212,36 @@ _FITS_FUZZY = "xfuzzy_rrt.planners.fuzzy_rrt:check_rulebook_fits"
 _FITS_CONNECT = "xfuzzy_rrt.planners.connect:check_connect_rulebook"
 _CORE_FUZZY = "xfuzzy_rrt.planners.fuzzy_rrt:plan_fuzzy_rrt"
 _CORE_CONNECT = "xfuzzy_rrt.planners.connect:plan_fuzzy_rrt_connect"
+_BIND_RRT = f"{_API}:bind_rrt_label"
+_BIND_RULEBOOK = f"{_API}:bind_rulebook_label"
+_CORE_BIND_FUZZY = "xfuzzy_rrt.planners.fuzzy_rrt:bind_fuzzy_rrt"
+_CORE_BIND_CONNECT = "xfuzzy_rrt.planners.connect:bind_fuzzy_rrt_connect"
 
-register(Planner("rrt", "rrt", f"{_API}:plan_rrt_label", params="rrt", help="rrt"))
+register(Planner("rrt", "rrt", f"{_API}:plan_rrt_label", params="rrt", help="rrt",
+                 bind=_BIND_RRT))
 register(Planner(
     "fuzzy-rrt", "fuzzy-rrt", f"{_API}:plan_rulebook_label", takes_rulebook=True, traces=True,
-    params="fuzzy-rrt", core=_CORE_FUZZY, fits=_FITS_FUZZY,
+    params="fuzzy-rrt", core=_CORE_FUZZY, fits=_FITS_FUZZY, bind=_BIND_RULEBOOK,
+    core_bind=_CORE_BIND_FUZZY,
     help="fuzzy-rrt (without --rulebook: goal-frame on one 2-joint arm, else fuzzy-rrt-connect "
          "with goal-frame-any; the JSON's planner_used says which ran)"))
 register(Planner(
     "fuzzy-rrt-connect", "fuzzy-rrt-connect", f"{_API}:plan_rulebook_label",
     takes_rulebook=True, traces=True, params="fuzzy-rrt", core=_CORE_CONNECT,
-    fits=_FITS_CONNECT))
+    fits=_FITS_CONNECT, bind=_BIND_RULEBOOK, core_bind=_CORE_BIND_CONNECT))
 register(Planner("rrt:tuned", "rrt", f"{_API}:plan_rrt_label", parse=f"{_API}:parse_tuned",
-                  plan_rechecks=True,
-                 params="rrt"))
+                 plan_rechecks=True, params="rrt", bind=_BIND_RRT))
 register(Planner(
     "fuzzy-rrt:", "fuzzy-rrt", f"{_API}:plan_rulebook_label", arg="RULEBOOK",
     parse=f"{_API}:parse_rulebook_arg", takes_rulebook=True, traces=True, params="fuzzy-rrt",
-    core=_CORE_FUZZY, fits=_FITS_FUZZY,
+    core=_CORE_FUZZY, fits=_FITS_FUZZY, bind=_BIND_RULEBOOK, core_bind=_CORE_BIND_FUZZY,
     help="fuzzy-rrt:NAME (a shipped rulebook) or fuzzy-rrt:DIR"))
 register(Planner(
     "fuzzy-rrt-connect:", "fuzzy-rrt-connect", f"{_API}:plan_rulebook_label", arg="RULEBOOK",
     parse=f"{_API}:parse_rulebook_arg", takes_rulebook=True, traces=True, params="fuzzy-rrt",
-    core=_CORE_CONNECT, fits=_FITS_CONNECT,
+    core=_CORE_CONNECT, fits=_FITS_CONNECT, bind=_BIND_RULEBOOK, core_bind=_CORE_BIND_CONNECT,
     help="fuzzy-rrt-connect[:NAME|:DIR] (two goal-frame trees; default rulebook goal-frame-any, "
          "any arm)"))
 register(Planner(
     "ompl:", "ompl", f"{_API}:plan_ompl_label", arg="NAME", parse=f"{_API}:parse_ompl_arg",
-    first_solution=False, help="ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)"))
+    first_solution=False, bind=f"{_API}:bind_ompl_label", help="ompl:NAME (e.g. ompl:RRTConnect; optional 'ompl' extra)"))

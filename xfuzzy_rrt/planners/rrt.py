@@ -11,6 +11,7 @@ Fuzzy-RRT: every sample counts, accepted or not.
 
 from __future__ import annotations
 
+import functools
 import time
 from typing import Any, NamedTuple
 
@@ -147,6 +148,22 @@ def plan_rrt_as(label: str, extra_params: dict | None, scenario: Scenario, seed:
     else:
         setup = _prepare(scenario, max_iter, step_deg, goal_bias, margin, clearance_m,
                          max_time_s)
+    return _run(setup, scenario.name, label, extra_params, seed, max_time_s)
+
+
+def bind_rrt_as(label: str, extra_params: dict | None, scenario: Scenario, *, max_iter,
+                step_deg, goal_bias, clearance_m):
+    """:func:`plan_rrt_as` without a time budget, for every seed: ``run(seed) -> PlanResult``,
+    the same result (what ``plan_scenario`` keeps for a loop of calls: ``api._LANES``)."""
+    return functools.partial(_run, _setup_for(scenario, max_iter, step_deg, goal_bias, None,
+                                              clearance_m), scenario.name, label,
+                             extra_params)
+
+
+def _run(setup: _Setup, name: str, label: str, extra_params: dict | None, seed,
+         max_time_s=None) -> PlanResult:
+    """One run of a checked set-up (:func:`plan_rrt_as`) of the scenario called ``name`` (the
+    name, not the scenario: a kept run must not keep its scenario alive)."""
     a, margin, params = setup.arrays, setup.margin, setup.params
     max_iter = int(params["max_iter"])
     head = setup.problem_head
@@ -170,7 +187,7 @@ def plan_rrt_as(label: str, extra_params: dict | None, scenario: Scenario, seed:
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
     return certified_result(
         a, margin, bool(ok), edges_certified=True, within_limits=within,
-        scenario=scenario.name, planner=label, planner_used=label, seed=int(seed),
+        scenario=name, planner=label, planner_used=label, seed=int(seed),
         iterations=int(iterations), nodes=int(n), cost_deg=cost if ok else None, wall_s=wall,
         path_deg=path, tree_nodes_deg=nodes, tree_parent=parents, work=int(work),
         params=recorded if extra_params is None else {**recorded, **extra_params},

@@ -94,3 +94,19 @@ def test_pyfuzzylite_agrees_with_rules_eval(tmp_path, run_cli):
         result = json.loads(proc.stdout)
         assert result["pyfuzzylite"].startswith("8.")
         assert result["max"] <= 1e-9
+
+
+def test_import_names_a_term_named_twice_with_its_file_and_line(tmp_path):
+    # found by the FLL fuzzer: a ValueError traceback from the partition's own check
+    export_fll(load_rulebook(EXPERT), tmp_path)
+    f = tmp_path / "bound_1.fll"
+    text = f.read_text()
+    south = "term: south Triangle 3.1415926535897931 4.7123889803846897 6.2831853071795862"
+    assert south in text
+    f.write_text(text.replace(south, south.replace("south", "north"), 1))
+    with pytest.raises(RulebookError) as info:
+        import_fll(tmp_path)
+    msgs = info.value.lines()
+    line = next(n for n, row in enumerate(f.read_text().splitlines(), 1)
+                if row.strip().startswith("term: north Triangle 3.14"))
+    assert any(f"bound_1.fll:{line}:" in m and "'north' is named twice" in m for m in msgs), msgs

@@ -345,6 +345,13 @@ def _partition(v: _Var, problem, sem: "_sem.Semantics") -> InputPartition | None
             problem(n, f"term {tname!r}: only Triangle and Ramp terms are supported, got {ttype} {' '.join(params)}")
             return None
         shapes.append((shape[1], shape, tname, n))
+    seen = {}
+    for _, _, tname, n in shapes:
+        if tname in seen:  # rules name terms, so two of one name cannot both be meant
+            problem(n, f"{v.name}: term {tname!r} is named twice (also on line {seen[tname]}); "
+                       "term names must be distinct")
+            return None
+        seen[tname] = n
     shapes.sort(key=lambda s: s[0])
     lo, hi = sem.input_ranges[v.name]
     peaks = [s[0] for s in shapes]

@@ -100,8 +100,8 @@ class Semantics:
     #: empty: training does not make it. Fuzzy-RRT plans with it only when it has a
     #: :attr:`kernel`.
     modes: Mapping[str, int] = field(default_factory=lambda: MappingProxyType({}))
-    #: The Fuzzy-RRT kernel entry (plain-tuple arguments, the signature of
-    #: ``planners/fuzzy_rrt.py:fuzzy_rrt_entry``), or ``None``.
+    #: The Fuzzy-RRT kernel entry (the problem and the tree as arenas, the signature and the
+    #: finished run it returns of ``planners/fuzzy_rrt.py:fuzzy_rrt_entry``), or ``None``.
     kernel: object = None
     #: The fitness evaluation of a population in training: ``fn(problem, tree, knots_b,
     #: consts_b, mode, seeds, max_iter) -> int64[P, R]`` iterations (``-1``: failed); one that

@@ -71,19 +71,6 @@ def new_work_counter() -> np.ndarray:
     return np.zeros(1, dtype=np.int64)
 
 
-@nb.njit(cache=True, nogil=True, inline="always")
-def counting_problem(head):
-    """The :class:`Problem` of ``head`` -- its first ten fields as a plain tuple, a planner
-    set-up's ``problem_head`` -- with a fresh zeroed ``work`` counter made here.
-
-    Why in compiled code: the planners' entries take the head and build the record inside
-    (numba types and unboxes a named tuple's fields in Python on every call), and a counter
-    made here is one array less for the call to unbox and one NumPy call less in Python (the
-    planners return the count; docs/peer-measurements.md, twenty-second session)."""
-    return Problem(head[0], head[1], head[2], head[3], head[4], head[5], head[6], head[7],
-                   head[8], head[9], np.zeros(1, dtype=np.int64))
-
-
 def single_arm_problem(links, base, radius, obstacles, limits, start=None, goal=None,
                        margin: float = 1e-6) -> Problem:
     """A one-arm :class:`Problem` from the old positional pieces (tests, small tools); its

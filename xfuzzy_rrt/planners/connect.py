@@ -99,7 +99,8 @@ from xfuzzy_rrt.planners.result import (
 from xfuzzy_rrt.planners.rng import seed_state
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import TraceArrays, make_trace, record_iteration
-from xfuzzy_rrt.geometry.problem import Problem, counting_problem
+from xfuzzy_rrt.geometry.problem import Problem
+from xfuzzy_rrt.planners.problem_arena import make_problem_arena, problem_in
 from xfuzzy_rrt.planners.prepared import pooled_trees, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import set_up
 from xfuzzy_rrt.planners.tree import NN_VISITS, add_node, nearest
@@ -385,10 +386,10 @@ def finish_connect_run(nodes_a, parent_a, na, nodes_b, parent_b, nb_, last_a, la
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def connect_entry(head, block_a, layout_a, block_b, layout_b, seed, max_iter, knots, consts,
-                  scale, min_step, stop, tr, grown, connect_nodes):
-    """:func:`connect_kernel` with the problem's head and the trace bundle as *plain* tuples
-    and the two trees as their arenas, emptied here (see
+def connect_entry(pblock, playout, block_a, layout_a, block_b, layout_b, seed, max_iter, knots,
+                  consts, scale, min_step, stop, tr, grown, connect_nodes):
+    """:func:`connect_kernel` with the problem and the two trees as their arenas (the trees
+    emptied here) and the trace bundle as a *plain* tuple (see
     :func:`xfuzzy_rrt.planners.rrt.rrt_entry`); the goal tree's view of the problem is built in
     the kernel's loop (:func:`reversed_problem`), not unboxed a second time. Returns the run
     finished, in one call: the kernel's four values, the number of extensions attempted, both
@@ -399,7 +400,7 @@ def connect_entry(head, block_a, layout_a, block_b, layout_b, seed, max_iter, kn
     ``None`` too): the kernel compiled without trace code runs, and no trace array is unboxed
     (an untraced call passed 16 idle arrays until the eleventh session, ~12 us of a 3-joint
     call with cold caches; docs/peer-measurements.md)."""
-    P = counting_problem(head)
+    P = problem_in(pblock, playout)
     TA = emptied_tree_in(block_a, layout_a)
     TB = emptied_tree_in(block_b, layout_b)
     counts = np.zeros(1, dtype=np.int64)
@@ -433,7 +434,9 @@ class _Setup(NamedTuple):
     knots: np.ndarray
     consts: np.ndarray
     scale: float
-    forward_head: tuple
+    #: the problem in one block (:mod:`~xfuzzy_rrt.planners.problem_arena`; the goal tree's
+    #: view, start and goal swapped, is made in the kernel: :func:`reversed_problem`)
+    problem: Any
     #: the result's ``params`` as far as the set-up fixes them (each call copies it)
     recorded: dict
     #: nodes per tree (:func:`tree_capacity`; kept here: one Python call less per plan)
@@ -450,12 +453,11 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     knots, consts = rb.compiled
     scale = length_scale(rb.semantics, scenario.dof)
     a = scenario_arrays(scenario)
-    # all but the work counter, fresh per call (both directions share it: reversed_problem)
     min_step = float(params["min_step_deg"])
     recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
                 "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
     return _Setup(rb, a, margin, int(max_iter), min_step, params, knots, consts, scale,
-                  tuple(a.problem(margin))[:-1], recorded, tree_capacity(max_iter))
+                  make_problem_arena(a.problem(margin)), recorded, tree_capacity(max_iter))
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -508,7 +510,7 @@ def _run(setup: _Setup, name: str, label: str, seed, trace=False,
         tr = tuple(buffers)
     else:  # no trace: the kernel compiled without trace code runs
         tr = grown = connect_nodes = None
-    args = (setup.forward_head, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout,
+    args = (*setup.problem, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout,
             int(seed))
     recorded = dict(setup.recorded)
     if max_time_s is None:  # the entry called here, not through a helper (one Python call less)

@@ -61,7 +61,6 @@ from xfuzzy_rrt.fuzzy.rulebook import default_rulebook_str, load_rulebook_cached
 from xfuzzy_rrt.fuzzy.variables import MAX_FIRED
 from xfuzzy_rrt.geometry.collision import direction_and_distance, nearest_obstacle_for_arm
 from xfuzzy_rrt.geometry.kinematics import arm_end_effector
-from xfuzzy_rrt.geometry.problem import counting_problem
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
@@ -76,6 +75,7 @@ from xfuzzy_rrt.planners.trace_record import (
     make_trace,
     record_iteration,
 )
+from xfuzzy_rrt.planners.problem_arena import make_problem_arena, problem_in
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
 from xfuzzy_rrt.planners.setup_memo import set_up
 from xfuzzy_rrt.planners.tree import add_node, nearest
@@ -276,13 +276,14 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def fuzzy_rrt_entry(head, block, layout, seed, max_iter, knots, consts, bounds_mode, min_step,
-                    stop, tr):
-    """:func:`fuzzy_rrt_kernel` with the problem's head and the trace bundle as *plain* tuples
-    and the tree as its arena, emptied here; returns the run finished (see
-    :func:`xfuzzy_rrt.planners.rrt.rrt_entry`: what a semantics' kernel entry returns). ``tr``
-    ``None``: a run that records nothing, through the kernel compiled without trace code."""
-    P = counting_problem(head)
+def fuzzy_rrt_entry(pblock, playout, block, layout, seed, max_iter, knots, consts, bounds_mode,
+                    min_step, stop, tr):
+    """:func:`fuzzy_rrt_kernel` with the problem and the tree as their arenas (the tree emptied
+    here) and the trace bundle as a *plain* tuple; returns the run finished (see
+    :func:`xfuzzy_rrt.planners.rrt.rrt_entry`: what a semantics' kernel entry takes and
+    returns). ``tr`` ``None``: a run that records nothing, through the kernel compiled without
+    trace code."""
+    P = problem_in(pblock, playout)
     T = emptied_tree_in(block, layout)
     if tr is None:  # decided when compiled: the branch not taken is not compiled at all
         ok, it, last = fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode,
@@ -294,10 +295,10 @@ def fuzzy_rrt_entry(head, block, layout, seed, max_iter, knots, consts, bounds_m
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def goal_frame_entry(head, block, layout, seed, max_iter, knots, consts, mode, min_step, stop,
-                     tr):
+def goal_frame_entry(pblock, playout, block, layout, seed, max_iter, knots, consts, mode,
+                     min_step, stop, tr):
     """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, called as above."""
-    P = counting_problem(head)
+    P = problem_in(pblock, playout)
     T = emptied_tree_in(block, layout)
     if tr is None:  # decided when compiled, as above
         ok, it, last = goal_frame_kernel(P, T, seed, max_iter, knots, consts, mode, min_step,
@@ -352,7 +353,8 @@ class _Setup(NamedTuple):
     knots: np.ndarray
     consts: np.ndarray
     groups: int
-    problem_head: tuple
+    #: the problem in one block (:mod:`~xfuzzy_rrt.planners.problem_arena`)
+    problem: Any
     #: the result's ``params`` as far as the set-up fixes them (each call copies it)
     recorded: dict
 
@@ -368,12 +370,12 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     mode = kernel_mode(rb)
     a = scenario_arrays(scenario)
     groups = fis_groups(rb, scenario)
-    head = tuple(a.problem(margin))[:-1]  # all but the work counter, fresh per call
+    problem = make_problem_arena(a.problem(margin))  # its work counter is made per call
     recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
                 "bounds": rb.bounds_mode, "min_step_deg": float(min_step_deg),
                 "margin_m": float(margin)}
     return _Setup(rb, a, margin, int(max_iter), float(min_step_deg), params, entry_for(mode),
-                  mode, knots, consts, groups, head, recorded)
+                  mode, knots, consts, groups, problem, recorded)
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -421,7 +423,7 @@ def _run(setup: _Setup, name: str, label: str, seed, trace=False,
     called ``name`` (the name, not the scenario: a kept run must not keep its scenario alive)."""
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, mode, kernel = setup.knots, setup.consts, setup.mode, setup.kernel
-    head = setup.problem_head
+    pblock, playout = setup.problem
     arena = pooled_tree(max_iter + 2, a.limits_deg, a.stop_width)
     block, layout = arena.block, arena.layout
     # untraced: None, and the kernel compiled without trace code runs
@@ -430,17 +432,17 @@ def _run(setup: _Setup, name: str, label: str, seed, trace=False,
     if max_time_s is None:
         t0 = time.perf_counter()
         ok, iterations, last, n, nodes, parents, path, cost, within, work = kernel(
-            head, block, layout, int(seed), max_iter, knots, consts, mode, setup.min_step,
-            NEVER_STOPPED, buffers)
+            pblock, playout, block, layout, int(seed), max_iter, knots, consts, mode,
+            setup.min_step, NEVER_STOPPED, buffers)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        kernel(head, block, layout, int(seed), 0, knots, consts, mode, setup.min_step,
-               np.zeros(1, dtype=np.int64), buffers)
+        kernel(pblock, playout, block, layout, int(seed), 0, knots, consts, mode,
+               setup.min_step, np.zeros(1, dtype=np.int64), buffers)
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
             ok, iterations, last, n, nodes, parents, path, cost, within, work = kernel(
-                head, block, layout, int(seed), max_iter, knots, consts, mode, setup.min_step,
-                flag.array, buffers)
+                pblock, playout, block, layout, int(seed), max_iter, knots, consts, mode,
+                setup.min_step, flag.array, buffers)
             wall = time.perf_counter() - t0
         recorded["max_time_s"] = float(setup.params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)

@@ -18,7 +18,6 @@ from typing import Any, NamedTuple
 import numba as nb
 import numpy as np
 
-from xfuzzy_rrt.geometry.problem import counting_problem
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
@@ -27,6 +26,7 @@ from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_resul
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
+from xfuzzy_rrt.planners.problem_arena import make_problem_arena, problem_in
 from xfuzzy_rrt.planners.setup_memo import set_up
 from xfuzzy_rrt.planners.tree import add_node, nearest
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in
@@ -73,19 +73,19 @@ def _rrt_loop(P, T, seed, max_iter, step, goal_bias, stop, state, sample, q_near
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
-def rrt_entry(head, block, layout, seed, max_iter, step, goal_bias, stop):
-    """:func:`rrt_kernel` called with the problem's ``head`` as a *plain* tuple (its work
-    counter is made here: :func:`~xfuzzy_rrt.geometry.problem.counting_problem`) and the tree
-    as its arena (:mod:`~xfuzzy_rrt.planners.tree_arena`), emptied here; returns the run
-    finished (:func:`~xfuzzy_rrt.planners.result.finished_tree`: the kernel's three values,
-    the tree's size, its copies, the path, its cost, the limits re-check and the work).
+def rrt_entry(pblock, playout, block, layout, seed, max_iter, step, goal_bias, stop):
+    """:func:`rrt_kernel` called with the problem as its arena
+    (:mod:`~xfuzzy_rrt.planners.problem_arena`, the work counter made here) and the tree as its
+    arena (:mod:`~xfuzzy_rrt.planners.tree_arena`), emptied here; returns the run finished
+    (:func:`~xfuzzy_rrt.planners.result.finished_tree`: the kernel's three values, the tree's
+    size, its copies, the path, its cost, the limits re-check and the work).
 
-    Why: numba types a named-tuple argument in Python, element by element, on every call
-    (20-40 us for our two bundles, as much as a short 2-DOF plan); a plain tuple of arrays is
-    typed by its fast C path, and one block instead of the tree's 17 arrays is unboxed once.
-    The bundles are rebuilt here, inside compiled code, for free.
+    Why: numba types and unboxes every argument in Python on every call (a named tuple element
+    by element: 20-40 us for our two bundles, as much as a short 2-DOF plan); one block and a
+    layout table each instead of the problem's eight arrays and the tree's 17 are unboxed
+    once, and the bundles are rebuilt here, inside compiled code, for free.
     """
-    P = counting_problem(head)
+    P = problem_in(pblock, playout)
     T = emptied_tree_in(block, layout)
     ok, it, last = rrt_kernel(P, T, seed, max_iter, step, goal_bias, stop)
     return finished_tree(P, T, ok, it, last)
@@ -98,7 +98,8 @@ class _Setup(NamedTuple):
     arrays: Any
     margin: float
     params: dict
-    problem_head: tuple
+    #: the problem in one block (:mod:`~xfuzzy_rrt.planners.problem_arena`)
+    problem: Any
     recorded: dict
 
 
@@ -111,7 +112,7 @@ def _prepare(scenario: Scenario, max_iter, step_deg, goal_bias, margin, clearanc
     a = scenario_arrays(scenario)
     recorded = {"step_deg": float(params["step_deg"]), "goal_bias": float(params["goal_bias"]),
                 "max_iter": int(params["max_iter"]), "margin_m": float(margin)}
-    return _Setup(a, margin, params, tuple(a.problem(margin))[:-1], recorded)
+    return _Setup(a, margin, params, make_problem_arena(a.problem(margin)), recorded)
 
 
 def _setup_for(scenario: Scenario, max_iter, step_deg, goal_bias, margin,
@@ -166,7 +167,7 @@ def _run(setup: _Setup, name: str, label: str, extra_params: dict | None, seed,
     name, not the scenario: a kept run must not keep its scenario alive)."""
     a, margin, params = setup.arrays, setup.margin, setup.params
     max_iter = int(params["max_iter"])
-    head = setup.problem_head
+    pblock, playout = setup.problem
     arena = pooled_tree(max_iter + 2, a.limits_deg, a.stop_width)
     block, layout = arena.block, arena.layout
     step, bias = float(params["step_deg"]), float(params["goal_bias"])
@@ -174,14 +175,15 @@ def _run(setup: _Setup, name: str, label: str, extra_params: dict | None, seed,
     if max_time_s is None:
         t0 = time.perf_counter()
         ok, iterations, _, n, nodes, parents, path, cost, within, work = rrt_entry(
-            head, block, layout, int(seed), max_iter, step, bias, NEVER_STOPPED)
+            pblock, playout, block, layout, int(seed), max_iter, step, bias, NEVER_STOPPED)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
-        rrt_entry(head, block, layout, int(seed), 0, step, bias, np.zeros(1, dtype=np.int64))
+        rrt_entry(pblock, playout, block, layout, int(seed), 0, step, bias,
+                  np.zeros(1, dtype=np.int64))
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
             ok, iterations, _, n, nodes, parents, path, cost, within, work = rrt_entry(
-                head, block, layout, int(seed), max_iter, step, bias, flag.array)
+                pblock, playout, block, layout, int(seed), max_iter, step, bias, flag.array)
             wall = time.perf_counter() - t0
         recorded["max_time_s"] = float(params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)

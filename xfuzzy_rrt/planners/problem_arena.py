@@ -2,14 +2,15 @@
 one array and a small layout table instead of a tuple of eight arrays and two numbers.
 
 Why: numba types and unboxes every array of a call's arguments, a tuple's one by one, on every
-call: the problem's eight arrays cost ~1.6 us of a 2-joint call with the caches warm and ~16 us
-with them cold, for every planner (a compiled no-op taking a tuple of nine arrays against one
-taking one array: 3.5 against 1.7 us warm, 45 against 28 us cold; docs/peer-measurements.md,
-twenty-second session). As for the search trees (:mod:`.tree_arena`), the arrays are copied
-once per set-up into a ``uint8`` block at 64-byte aligned offsets, and a compiled entry
-rebuilds the :class:`~xfuzzy_rrt.geometry.problem.Problem` from the block with slices and
-``view``/``reshape`` (no copy; numba types the views exactly as it typed the separate arrays,
-so every kernel keeps its one specialisation), with a fresh zeroed ``work`` counter made there.
+call. A compiled no-op taking a tuple of nine arrays against one taking one array: 3.5 against
+1.7 us warm, 45 against 28 us cold. In whole 2-joint calls the problem as a block saved less,
+~0.5 us warm and nothing measurable cold (docs/peer-measurements.md, twenty-second session):
+rebuilding the views costs a little of what unboxing cost. As for the search trees
+(:mod:`.tree_arena`, whose packing it uses), the arrays are copied once per set-up into a
+``uint8`` block at 64-byte aligned offsets, and a compiled entry rebuilds the
+:class:`~xfuzzy_rrt.geometry.problem.Problem` from the block with slices and ``view``/``reshape``
+(no copy; numba types the views exactly as it typed the separate arrays, so every kernel keeps
+its one specialisation), with a fresh zeroed ``work`` counter made there.
 
 No kernel writes into a problem's arrays (only into its ``work`` counter, made per call), so
 the block is shared by every thread that plans the scenario with those settings: it belongs to
@@ -25,6 +26,7 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.geometry.problem import Problem
+from xfuzzy_rrt.planners.tree_arena import field_bytes, packed
 
 #: dtype and number of dimensions of each array field of :class:`Problem` before ``margin``,
 #: in order (links, arm_first, bases, radii, obstacles, limits, start, goal); row
@@ -32,7 +34,6 @@ from xfuzzy_rrt.geometry.problem import Problem
 FIELD_KINDS = ((np.float64, 1), (np.int64, 1), (np.float64, 2), (np.float64, 1),
                (np.float64, 2), (np.float64, 2), (np.float64, 1), (np.float64, 1))
 NUMBERS = len(FIELD_KINDS)
-_ALIGN = 64
 
 
 class ProblemArena(NamedTuple):
@@ -52,22 +53,8 @@ def make_problem_arena(problem: Problem) -> ProblemArena:
             raise TypeError(f"problem field {Problem._fields[k]} is {arr.ndim}-D; the arena "
                             f"expects {ndim}-D (FIELD_KINDS)")
     parts.append(np.array([problem.margin, problem.clearance], dtype=np.float64))
-    layout = np.zeros((len(parts), 4), dtype=np.int64)
-    offset = 0
-    for k, arr in enumerate(parts):
-        layout[k] = (offset, arr.nbytes, arr.shape[0], arr.shape[1] if arr.ndim == 2 else 0)
-        offset += -(-arr.nbytes // _ALIGN) * _ALIGN
-    block = np.zeros(offset + _ALIGN, dtype=np.uint8)
-    layout[:, 0] += (-block.ctypes.data) % _ALIGN  # start at the first 64-byte boundary
-    for k, arr in enumerate(parts):
-        o, n = int(layout[k, 0]), int(layout[k, 1])
-        block[o:o + n].view(arr.dtype).reshape(arr.shape)[...] = arr
+    block, layout, _ = packed(parts)
     return ProblemArena(block, layout)
-
-
-@nb.njit(cache=True, nogil=True, inline="always")
-def _raw(b, L, k):
-    return b[L[k, 0]:L[k, 0] + L[k, 1]]
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -75,10 +62,14 @@ def problem_in(block, layout):
     """The :class:`Problem` whose arrays are ``block``'s fields (views, no copy), with a fresh
     zeroed ``work`` counter made here (each plan counts its own work)."""
     f8, i8, L = np.float64, np.int64, layout
-    numbers = _raw(block, L, NUMBERS).view(f8)
+    numbers = field_bytes(block, L, NUMBERS).view(f8)
     return Problem(
-        _raw(block, L, 0).view(f8), _raw(block, L, 1).view(i8),
-        _raw(block, L, 2).view(f8).reshape((L[2, 2], L[2, 3])), _raw(block, L, 3).view(f8),
-        _raw(block, L, 4).view(f8).reshape((L[4, 2], L[4, 3])),
-        _raw(block, L, 5).view(f8).reshape((L[5, 2], L[5, 3])), _raw(block, L, 6).view(f8),
-        _raw(block, L, 7).view(f8), numbers[0], numbers[1], np.zeros(1, dtype=np.int64))
+        field_bytes(block, L, 0).view(f8),
+        field_bytes(block, L, 1).view(i8),
+        field_bytes(block, L, 2).view(f8).reshape((L[2, 2], L[2, 3])),
+        field_bytes(block, L, 3).view(f8),
+        field_bytes(block, L, 4).view(f8).reshape((L[4, 2], L[4, 3])),
+        field_bytes(block, L, 5).view(f8).reshape((L[5, 2], L[5, 3])),
+        field_bytes(block, L, 6).view(f8),
+        field_bytes(block, L, 7).view(f8),
+        numbers[0], numbers[1], np.zeros(1, dtype=np.int64))

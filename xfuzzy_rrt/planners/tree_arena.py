@@ -56,6 +56,15 @@ def make_tree_arena(capacity: int, limits_deg: np.ndarray, stops: int = 0) -> Tr
         if arr.dtype != dtype or arr.ndim != ndim:
             raise TypeError(f"tree field {name} is {arr.dtype}[{arr.ndim}-D]; the arena "
                             f"expects {np.dtype(dtype)}[{ndim}-D] (FIELD_KINDS)")
+    block, layout, views = packed(parts)
+    return TreeArena(TreeArrays(*views[:META0]), block, layout)
+
+
+def packed(parts) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """``(block, layout, views)``: the 1-D or 2-D arrays *parts* copied into one ``uint8``
+    block, each at a 64-byte boundary, ``layout[k] = offset, nbytes, rows, cols`` (``cols`` 0
+    for a 1-D part), and the views of the block that hold them (what :func:`tree_in` and
+    :func:`~xfuzzy_rrt.planners.problem_arena.problem_in` rebuild in compiled code)."""
     layout = np.zeros((len(parts), 4), dtype=np.int64)
     offset = 0
     for k, arr in enumerate(parts):
@@ -71,11 +80,11 @@ def make_tree_arena(capacity: int, limits_deg: np.ndarray, stops: int = 0) -> Tr
         view = block[o:o + n].view(arr.dtype).reshape(arr.shape)
         view[...] = arr
         views.append(view)
-    return TreeArena(TreeArrays(*views[:META0]), block, layout)
+    return block, layout, views
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _raw(b, L, k):
+def field_bytes(b, L, k):
     """Field ``k``'s bytes."""
     return b[L[k, 0]:L[k, 0] + L[k, 1]]
 
@@ -90,14 +99,23 @@ def tree_in(block, layout):
     """The :class:`TreeArrays` whose arrays are ``block``'s fields (views, no copy)."""
     f8, i8, L = np.float64, np.int64, layout
     return TreeArrays(
-        _raw(block, L, 0).view(f8).reshape(_rows(L, 0)), _raw(block, L, 1).view(i8),
-        _raw(block, L, 2).view(i8), _raw(block, L, 3).view(i8), _raw(block, L, 4).view(i8),
-        _raw(block, L, 5).view(f8), _raw(block, L, 6).view(i8), _raw(block, L, 7).view(i8),
-        _raw(block, L, 8).view(i8).reshape(_rows(L, 8)), _raw(block, L, 9).view(f8),
-        _raw(block, L, 10).view(f8).reshape(_rows(L, 10)), _raw(block, L, 11).view(f8),
-        _raw(block, L, 12).view(f8).reshape(_rows(L, 12)), _raw(block, L, 13).view(np.uint64),
-        _raw(block, L, 14).view(f8).reshape(_rows(L, 14)), _raw(block, L, 15).view(f8),
-        _raw(block, L, 16).view(f8).reshape(_rows(L, 16)))
+        field_bytes(block, L, 0).view(f8).reshape(_rows(L, 0)),
+        field_bytes(block, L, 1).view(i8),
+        field_bytes(block, L, 2).view(i8),
+        field_bytes(block, L, 3).view(i8),
+        field_bytes(block, L, 4).view(i8),
+        field_bytes(block, L, 5).view(f8),
+        field_bytes(block, L, 6).view(i8),
+        field_bytes(block, L, 7).view(i8),
+        field_bytes(block, L, 8).view(i8).reshape(_rows(L, 8)),
+        field_bytes(block, L, 9).view(f8),
+        field_bytes(block, L, 10).view(f8).reshape(_rows(L, 10)),
+        field_bytes(block, L, 11).view(f8),
+        field_bytes(block, L, 12).view(f8).reshape(_rows(L, 12)),
+        field_bytes(block, L, 13).view(np.uint64),
+        field_bytes(block, L, 14).view(f8).reshape(_rows(L, 14)),
+        field_bytes(block, L, 15).view(f8),
+        field_bytes(block, L, 16).view(f8).reshape(_rows(L, 16)))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
@@ -105,5 +123,5 @@ def emptied_tree_in(block, layout):
     """:func:`tree_in`, emptied for a new run (:func:`~xfuzzy_rrt.planners.tree.reset_tree`
     with the block's own ``meta0``)."""
     T = tree_in(block, layout)
-    reset_tree(T, _raw(block, layout, META0).view(np.int64))
+    reset_tree(T, field_bytes(block, layout, META0).view(np.int64))
     return T

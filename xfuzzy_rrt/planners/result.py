@@ -266,6 +266,9 @@ class PlanResult:
     iterations: int
     nodes: int
     cost_deg: float | None
+    #: seconds of the planning call (for our planners, since the twenty-second session, the
+    #: compiled entry: search, path extraction and tree copies; never the path's certification
+    #: or anything before the entry): the kernel time of benchmark tables
     wall_s: float
     path_deg: np.ndarray
     tree_nodes_deg: np.ndarray = field(repr=False)

@@ -133,6 +133,10 @@ def test_another_setting_or_object_is_not_served_by_the_kept_run(problems, fresh
     assert plan_scenario(copy, "fuzzy-rrt", rulebook=default, seed=3).scenario == "renamed"
     plan_scenario(s, "rrt", seed=3, step_deg=10.0)
     assert plan_scenario(s, "rrt", seed=3, step_deg=20.0).params["step_deg"] == 20.0
+    assert plan_scenario(s, "rrt", seed=3, step_deg=20.0, goal_bias=0.5).params["goal_bias"] == 0.5
+    wide = plan_scenario(s, "fuzzy-rrt", rulebook=default, seed=3, clearance_m=0.002)
+    assert wide.params["margin_m"] > plan_scenario(s, "fuzzy-rrt", rulebook=default,
+                                                   seed=3).params["margin_m"]
 
 
 def test_a_bad_seed_is_refused_on_the_kept_run_too(problems, fresh):

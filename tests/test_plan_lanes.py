@@ -106,7 +106,7 @@ def test_an_ompl_peer_in_a_loop_gets_what_a_fresh_call_gets(problems, fresh):
             _same(r, _fresh_result(scenario, "ompl:RRTConnect", tuned, s))
     plan_scenario(problems[0], "ompl:RRTConnect", seed=0)  # the tuned file is read: no run kept
     assert ("ompl:RRTConnect", id(problems[0])) not in api._LANES or \
-        api._LANES[("ompl:RRTConnect", id(problems[0]))][1] is tuned
+        api._LANES[("ompl:RRTConnect", id(problems[0]))][1][0] is tuned
 
 
 def test_the_default_plans_each_arm_with_its_own_run(problems, fresh):

@@ -13,6 +13,7 @@ from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.fuzzy.rulebook import rulebooks_env
 from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners import registry as _registry
+from xfuzzy_rrt.planners import setup_memo as _setup_memo
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
 from xfuzzy_rrt.planners.rng import check_seed
 from xfuzzy_rrt.planners.rrt import plan_rrt, plan_rrt_as
@@ -301,11 +302,12 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
     :data:`_LANES`) goes straight to the run its registration's ``bind`` made then.
     """
     if not trace and max_time_s is None:
-        lane = _LANES.get((planner, id(scenario)))
-        if lane is not None and lane[0]() is scenario and lane[1] is rulebook and \
-                lane[2] is max_iter and lane[3] is step_deg and lane[4] is goal_bias and \
-                lane[5] is clearance_m:
-            return lane[6](check_seed(seed))
+        hit = _LANES.get((planner, id(scenario)))
+        if hit is not None and hit[0]() is scenario:
+            lane = hit[1]
+            if lane[0] is rulebook and lane[1] is max_iter and lane[2] is step_deg and \
+                    lane[3] is goal_bias and lane[4] is clearance_m:
+                return lane[5](check_seed(seed))
     check_seed(seed)
     spec = parse_planner(planner, "--planner", recheck=False)
     entry = spec.planner
@@ -316,16 +318,17 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
         run = entry.bind_fn(scenario, spec, rulebook, max_iter=max_iter, step_deg=step_deg,
                             goal_bias=goal_bias, clearance_m=clearance_m)
         if run is not None:
-            _keep_lane((planner, id(scenario)), scenario,
-                       (rulebook, max_iter, step_deg, goal_bias, clearance_m, run))
+            _setup_memo.remember((planner, id(scenario)), scenario,
+                                 (rulebook, max_iter, step_deg, goal_bias, clearance_m, run),
+                                 _LANES, MAX_LANES)
             return run(seed)
     return entry.plan_fn(scenario, spec, rulebook, seed=seed, max_iter=max_iter,
                          step_deg=step_deg, goal_bias=goal_bias, trace=trace,
                          clearance_m=clearance_m, max_time_s=max_time_s)
 
 
-#: ``(label, id(scenario))`` -> ``(weak reference to the scenario, rulebook, max_iter,
-#: step_deg, goal_bias, clearance_m, run)``: the run (``run(seed) -> PlanResult``) that a
+#: ``(label, id(scenario))`` -> ``(weak reference to the scenario, (rulebook, max_iter,
+#: step_deg, goal_bias, clearance_m, run))``: the run (``run(seed) -> PlanResult``) that a
 #: registration's ``bind`` made for a call without a trace or a time budget, used again by a
 #: call that passes the very same objects (``is``, one by one, as
 #: :func:`~xfuzzy_rrt.planners.setup_memo.last_call` matches).
@@ -338,32 +341,12 @@ def plan_scenario(scenario: Scenario, planner: str = "fuzzy-rrt", rulebook=None,
 #: call could change is read again: a loaded rulebook, the preloaded shipped default or tuned
 #: settings, or a label that reads nothing (``rrt``); ``bind`` returns None otherwise (a rulebook
 #: given as a folder or ``None`` is resolved again on every call, so an edit is noticed), and
-#: the call takes the registration's ``plan``. An entry goes with its scenario (a weak
+#: the call takes the registration's ``plan``. Kept by the set-up memo's own
+#: :func:`~xfuzzy_rrt.planners.setup_memo.remember`: an entry goes with its scenario (a weak
 #: reference whose callback drops it, so a recycled ``id`` never finds a dead scenario's run),
 #: and at most :data:`MAX_LANES` are kept, the oldest dropped.
 _LANES: dict = {}
 MAX_LANES = 1024
-
-
-def _keep_lane(key, scenario, lane) -> None:
-    try:
-        ref = weakref.ref(scenario, lambda r, k=key: _drop_lane(k, r))
-    except TypeError:  # not weak-referenceable: nothing is kept
-        return
-    _LANES.pop(key, None)
-    _LANES[key] = (ref, *lane)
-    while len(_LANES) > MAX_LANES:
-        try:
-            del _LANES[next(iter(_LANES))]
-        except (KeyError, StopIteration, RuntimeError):  # another thread trimmed it first
-            break
-
-
-def _drop_lane(key, ref) -> None:
-    """The scenario of ``key``'s run died: drop the entry if it is still that one's."""
-    lane = _LANES.get(key)
-    if lane is not None and lane[0] is ref:
-        _LANES.pop(key, None)
 
 
 def clear_lanes() -> None:

@@ -82,25 +82,31 @@ def lookup(key: Hashable, scenario: Any) -> Any | None:
     return hit[1]
 
 
-def remember(key: Hashable, scenario: Any, setup: Any) -> None:
-    """Keep ``setup`` for ``key`` (nothing is kept for a scenario without weak references)."""
+def remember(key: Hashable, scenario: Any, setup: Any, store: dict | None = None,
+             limit: int = MAX_ENTRIES) -> None:
+    """Keep ``setup`` for ``key`` as ``(weak reference to scenario, setup)`` in ``store`` (this
+    memo by default; ``api._LANES`` keeps its runs the same way), the oldest entries dropped
+    beyond ``limit``, an entry dropped when its scenario dies (nothing is kept for a scenario
+    without weak references)."""
+    store = _memo if store is None else store
     try:
-        ref = weakref.ref(scenario, lambda r, k=key: _forget(k, r))
+        ref = weakref.ref(scenario, lambda r, k=key, s=store: _forget(s, k, r))
     except TypeError:
         return
-    _memo[key] = (ref, setup)
-    while len(_memo) > MAX_ENTRIES:
+    store.pop(key, None)  # re-inserted last: the newest
+    store[key] = (ref, setup)
+    while len(store) > limit:
         try:
-            del _memo[next(iter(_memo))]
+            del store[next(iter(store))]
         except (KeyError, StopIteration, RuntimeError):  # another thread trimmed it first
             break
 
 
-def _forget(key: Hashable, ref: weakref.ref) -> None:
+def _forget(store: dict, key: Hashable, ref: weakref.ref) -> None:
     """The scenario of ``key``'s entry died: drop the entry if it is still that one's."""
-    hit = _memo.get(key)
+    hit = store.get(key)
     if hit is not None and hit[0] is ref:
-        _memo.pop(key, None)
+        store.pop(key, None)
 
 
 def remembered(key: Hashable, scenario: Any, prepare: Callable[[], Any], rulebook: Any = None,

@@ -364,6 +364,28 @@ def test_a_set_up_goes_with_its_scenario(scenarios, fresh_memo):
     assert len(setup_memo._memo) == 0
 
 
+def test_a_scenario_freed_after_the_memo_module_is_torn_down_drops_its_entry_silently(
+        monkeypatch):
+    """At interpreter exit a script's global scenario can die after the modules' names are
+    cleared (set to None); its entry's callback must not look ``_forget`` up then (it printed
+    "Exception ignored ... 'NoneType' object is not callable" after a benchmark run)."""
+    import gc
+    import sys
+
+    class Owner:  # any object with weak references, as a scenario has
+        pass
+
+    store: dict = {}
+    owner = Owner()
+    setup_memo.remember(("key", id(owner)), owner, "value", store)
+    complaints = []
+    monkeypatch.setattr(sys, "unraisablehook", complaints.append)
+    monkeypatch.setattr(setup_memo, "_forget", None)  # as module teardown leaves it
+    del owner
+    gc.collect()
+    assert complaints == [] and store == {}
+
+
 def test_a_loaded_rulebook_is_matched_by_identity_and_another_load_gets_its_own_set_up(
         scenarios, rulebook_copy, fresh_memo):
     from xfuzzy_rrt.planners.connect import plan_fuzzy_rrt_connect

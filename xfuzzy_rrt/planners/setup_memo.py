@@ -90,7 +90,10 @@ def remember(key: Hashable, scenario: Any, setup: Any, store: dict | None = None
     without weak references)."""
     store = _memo if store is None else store
     try:
-        ref = weakref.ref(scenario, lambda r, k=key, s=store: _forget(s, k, r))
+        # ``_forget`` is bound here, not looked up when the scenario dies: a scenario that
+        # outlives the module (a script's global, freed at interpreter exit after the modules'
+        # names are cleared) printed "Exception ignored ... 'NoneType' object is not callable"
+        ref = weakref.ref(scenario, lambda r, k=key, s=store, forget=_forget: forget(s, k, r))
     except TypeError:
         return
     store.pop(key, None)  # re-inserted last: the newest

@@ -177,3 +177,42 @@ def test_a_kept_run_goes_with_its_scenario(problems, fresh):
     del copy
     gc.collect()
     assert api._LANES == {} and len(setup_memo._memo) == 0
+
+
+def _same_but_the_budget(lane, general) -> None:
+    """A run through its lane and the same run through the general path (a time budget it
+    never reaches): every field and instance entry the same, save the clock and the budget's
+    own records in ``params``."""
+    _same(dataclasses.replace(lane, params={}), dataclasses.replace(general, params={}))
+    extra = {k: v for k, v in general.params.items() if k not in ("max_time_s", "stopped_by")}
+    assert lane.params == extra
+    assert set(lane.__dict__) == set(general.__dict__)
+    assert lane.min_clearance_m == general.min_clearance_m
+    assert lane.penetration_m == general.penetration_m
+
+
+@pytest.mark.parametrize("planner, loader", [
+    ("fuzzy-rrt", load_shipped_default),
+    ("rrt:tuned", load_tuned_rrt),
+    ("rrt", lambda: None),
+    ("fuzzy-rrt-connect", lambda: preloaded("fuzzy-rrt-connect", None)),
+])
+@pytest.mark.parametrize("max_iter", [10_000, 2])
+def test_a_lane_builds_the_result_the_general_path_builds(problems, fresh, planner, loader,
+                                                          max_iter):
+    """The lanes copy a template instead of calling ``certified_result`` (result.bound_result):
+    found or not, their results are the general path's, field for field."""
+    rulebook = loader()
+    found = []
+    for scenario in problems:
+        for seed in range(3):
+            lane = plan_scenario(scenario, planner, rulebook=rulebook, seed=seed,
+                                 max_iter=max_iter)
+            general = plan_scenario(scenario, planner, rulebook=rulebook, seed=seed,
+                                    max_iter=max_iter, max_time_s=600.0)
+            assert general.params["stopped_by"] != "time"
+            _same_but_the_budget(lane, general)
+            found.append(lane.found)
+    assert any(k[0] == planner for k in api._LANES)
+    # both branches of bound_result: every run found with room, some not with two iterations
+    assert all(found) if max_iter > 2 else not all(found)

@@ -64,7 +64,6 @@ other tree).
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 from typing import Any, NamedTuple
@@ -91,7 +90,9 @@ from xfuzzy_rrt.planners.result import (
     GOAL_REACHED,
     NODE_IN_COLLISION,
     PlanResult,
+    bound_result,
     certified_result,
+    certified_template,
     path_cost_compiled,
     replace_result,
     vertices_within,
@@ -441,6 +442,8 @@ class _Setup(NamedTuple):
     recorded: dict
     #: nodes per tree (:func:`tree_capacity`; kept here: one Python call less per plan)
     capacity: int
+    #: ``(scenario name, label)`` -> the run :func:`_lane` made for this set-up
+    lanes: dict
 
 
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -457,7 +460,7 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
     recorded = {"max_iter": int(max_iter), "semantics": rb.semantics.name,
                 "min_step_deg": min_step, "margin_m": float(margin), "length_scale": scale}
     return _Setup(rb, a, margin, int(max_iter), min_step, params, knots, consts, scale,
-                  make_problem_arena(a.problem(margin)), recorded, tree_capacity(max_iter))
+                  make_problem_arena(a.problem(margin)), recorded, tree_capacity(max_iter), {})
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -492,14 +495,59 @@ def bind_fuzzy_rrt_connect(scenario: Scenario, rulebook, *, max_iter, clearance_
     """:func:`plan_fuzzy_rrt_connect` without a trace or a time budget, for every seed:
     ``run(seed) -> PlanResult``, the same result (what ``plan_scenario`` keeps for a loop of
     calls: ``api._LANES``)."""
-    return functools.partial(_run, _setup_for(scenario, rulebook, max_iter, None, None,
-                                              clearance_m), scenario.name, label)
+    return _lane(_setup_for(scenario, rulebook, max_iter, None, None, clearance_m),
+                 scenario.name, label)
+
+
+def _lane(setup: _Setup, name: str, label: str):
+    """The untraced run of ``setup`` without a time budget, ``run(seed) -> PlanResult``, made
+    once per set-up, scenario name and label (``setup.lanes``): everything a run reads is
+    looked up here, once, and its result is :func:`~xfuzzy_rrt.planners.result.bound_result`'s
+    copy of a template. The same result as :func:`_run`'s general path (tests/test_plan_lanes.py
+    compares them field by field); why a separate path: result.bound_result."""
+    run = setup.lanes.get((name, label))
+    if run is not None:
+        return run
+    rb, a = setup.rb, setup.arrays
+    pblock, playout = setup.problem
+    knots, consts, scale, min_step, max_iter = (setup.knots, setup.consts, setup.scale,
+                                                setup.min_step, setup.max_iter)
+    trees_key = (setup.capacity, a.limits_deg, 2, a.stop_width)
+    recorded, margin = setup.recorded, float(setup.margin)
+    template = certified_template(
+        scenario=name, planner=label, planner_used=PLANNER, seed=0, iterations=0, nodes=0,
+        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
+        rulebook=rb.name, rulebook_sha256=rb.sha256, params=None, work=0)
+    clock = time.perf_counter
+
+    def run(seed):
+        arena_a, arena_b = pooled_trees(*trees_key)
+        t0 = clock()
+        (ok, iterations, last_a, last_b, extensions, na, nb_, nodes, parent, path, cost, within,
+         same, work) = connect_entry(pblock, playout, arena_a.block, arena_a.layout,
+                                     arena_b.block, arena_b.layout, seed, max_iter, knots,
+                                     consts, scale, min_step, NEVER_STOPPED, None, None, None)
+        wall = clock() - t0
+        if not same:
+            raise RuntimeError("fuzzy-rrt-connect: the two trees' junction nodes differ")
+        params = dict(recorded)
+        params["extensions"] = extensions
+        params["start_tree_nodes"] = na
+        params["goal_tree_nodes"] = nb_
+        return bound_result(template, a, margin, ok, within, seed, iterations, na + nb_, cost,
+                            wall, path, nodes, parent, work, params)
+
+    setup.lanes[(name, label)] = run
+    return run
 
 
 def _run(setup: _Setup, name: str, label: str, seed, trace=False,
          max_time_s=None) -> PlanResult:
     """One run of a checked set-up (:func:`plan_fuzzy_rrt_connect`) of the scenario
-    called ``name`` (the name, not the scenario: a kept run must not keep its scenario alive)."""
+    called ``name`` (the name, not the scenario: a kept run must not keep its scenario alive).
+    Untraced without a time budget: :func:`_lane`'s run."""
+    if not trace and max_time_s is None:
+        return _lane(setup, name, label)(int(seed))
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, scale, min_step = setup.knots, setup.consts, setup.scale, setup.min_step
     arena_a, arena_b = pooled_trees(setup.capacity, a.limits_deg, 2, a.stop_width)

@@ -48,7 +48,6 @@ Choices where the paper is silent or ambiguous (and why):
 
 from __future__ import annotations
 
-import functools
 import time
 from typing import Any, NamedTuple
 
@@ -66,8 +65,9 @@ from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.params import default
-from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, certified_result,
-                                         finished_tree, replace_result)
+from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, bound_result,
+                                       certified_result, certified_template, finished_tree,
+                                       replace_result)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import (
@@ -357,6 +357,8 @@ class _Setup(NamedTuple):
     problem: Any
     #: the result's ``params`` as far as the set-up fixes them (each call copies it)
     recorded: dict
+    #: ``(scenario name, label)`` -> the run :func:`_lane` made for this set-up
+    lanes: dict
 
 
 def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clearance_m,
@@ -375,7 +377,7 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
                 "bounds": rb.bounds_mode, "min_step_deg": float(min_step_deg),
                 "margin_m": float(margin)}
     return _Setup(rb, a, margin, int(max_iter), float(min_step_deg), params, entry_for(mode),
-                  mode, knots, consts, groups, problem, recorded)
+                  mode, knots, consts, groups, problem, recorded, {})
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -413,14 +415,52 @@ def bind_fuzzy_rrt(scenario: Scenario, rulebook, *, max_iter, clearance_m, label
     """:func:`plan_fuzzy_rrt` without a trace or a time budget, for every seed: ``run(seed) ->
     PlanResult``, the same result (what ``plan_scenario`` keeps for a loop of calls:
     ``api._LANES``)."""
-    return functools.partial(_run, _setup_for(scenario, rulebook, max_iter, MIN_STEP_DEG, None,
-                                              clearance_m), scenario.name, label)
+    return _lane(_setup_for(scenario, rulebook, max_iter, MIN_STEP_DEG, None, clearance_m),
+                 scenario.name, label)
+
+
+def _lane(setup: _Setup, name: str, label: str):
+    """The untraced run of ``setup`` without a time budget, ``run(seed) -> PlanResult``, made
+    once per set-up, scenario name and label (``setup.lanes``; the same result as
+    :func:`_run`'s general path, tests/test_plan_lanes.py): the twin of
+    :func:`xfuzzy_rrt.planners.connect._lane` (why: :func:`~xfuzzy_rrt.planners.result.
+    bound_result`)."""
+    run = setup.lanes.get((name, label))
+    if run is not None:
+        return run
+    rb, a, max_iter = setup.rb, setup.arrays, setup.max_iter
+    knots, consts, mode, kernel, min_step = (setup.knots, setup.consts, setup.mode,
+                                             setup.kernel, setup.min_step)
+    pblock, playout = setup.problem
+    tree_key = (max_iter + 2, a.limits_deg, a.stop_width)
+    recorded, margin = setup.recorded, float(setup.margin)
+    template = certified_template(
+        scenario=name, planner=label, planner_used="fuzzy-rrt", seed=0, iterations=0, nodes=0,
+        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
+        work=0, rulebook=rb.name, rulebook_sha256=rb.sha256, params=None)
+    clock = time.perf_counter
+
+    def run(seed):
+        arena = pooled_tree(*tree_key)
+        t0 = clock()
+        ok, iterations, _, n, nodes, parents, path, cost, within, work = kernel(
+            pblock, playout, arena.block, arena.layout, seed, max_iter, knots, consts, mode,
+            min_step, NEVER_STOPPED, None)
+        wall = clock() - t0
+        return bound_result(template, a, margin, ok, within, seed, iterations, n, cost, wall,
+                            path, nodes, parents, work, dict(recorded))
+
+    setup.lanes[(name, label)] = run
+    return run
 
 
 def _run(setup: _Setup, name: str, label: str, seed, trace=False,
          max_time_s=None) -> PlanResult:
     """One run of a checked set-up (:func:`plan_fuzzy_rrt`) of the scenario
-    called ``name`` (the name, not the scenario: a kept run must not keep its scenario alive)."""
+    called ``name`` (the name, not the scenario: a kept run must not keep its scenario alive).
+    Untraced without a time budget: :func:`_lane`'s run."""
+    if not trace and max_time_s is None:
+        return _lane(setup, name, label)(int(seed))
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
     knots, consts, mode, kernel = setup.knots, setup.consts, setup.mode, setup.kernel
     pblock, playout = setup.problem

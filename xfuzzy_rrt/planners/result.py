@@ -424,6 +424,60 @@ def _certified(fields: dict[str, Any]) -> PlanResult:
     return result
 
 
+def certified_template(**fields: Any) -> dict[str, Any]:
+    """The instance dictionary :func:`certified_result` gives a compiled planner's certified
+    path with these fields (every default, the certified state, then ``fields``, as
+    :func:`_certified` makes it), for :func:`bound_result` to copy and fill run by run: the
+    fields a run does not change (``scenario``, ``planner``, ``planner_used``, ``rulebook``,
+    ``rulebook_sha256``) are set once, the others are placeholders."""
+    return dict(_certified(fields).__dict__)
+
+
+def bound_result(template: dict[str, Any], arrays, margin: float, ok: bool, within: bool,
+                 seed: int, iterations: int, nodes: int, cost: float, wall: float, path,
+                 tree_nodes, tree_parent, work: int, params: dict) -> PlanResult:
+    """``certified_result(arrays, margin, ok, edges_certified=True, within_limits=within,
+    **fields)`` for a compiled planner's run, the fixed fields taken from ``template``
+    (:func:`certified_template`) and the run's own passed by position.
+
+    Why: a run kept for a loop of calls (``api._LANES``; every untraced call without a time
+    budget) spent more Python on its result than on its search when the caches are cold: the
+    keyword call, ``asarray``, the field checks of :func:`_certified` and the conversions cost
+    ~80 us of a 3-joint call of ~300 us, for every compiled planner alike (docs/peer-measurements.md,
+    twenty-third session). A certified path (found, every vertex within the limits, every edge
+    certified by the kernel) copies the template and sets the run's fields; anything else (a
+    failure) goes through :func:`certified_result` itself. The values are the ones the kernel
+    returned: Python ``int``/``bool``/``float`` already (numba boxes them so), as the general
+    path's ``int()``/``bool()`` leave them."""
+    if ok and within and path.shape[0] >= 2:
+        result = _new_object(PlanResult)
+        d = result.__dict__
+        d.update(template)
+        d["seed"] = seed
+        d["iterations"] = iterations
+        d["nodes"] = nodes
+        d["cost_deg"] = cost
+        d["wall_s"] = wall
+        d["path_deg"] = path
+        d["tree_nodes_deg"] = tree_nodes
+        d["tree_parent"] = tree_parent
+        d["work"] = work
+        d["params"] = params
+        d["_measurement"] = functools.partial(_path_check_module().path_min_clearance, arrays,
+                                              path, margin)
+        return result
+    return certified_result(
+        arrays, margin, bool(ok), edges_certified=True, within_limits=within,
+        scenario=template["scenario"], planner=template["planner"],
+        planner_used=template["planner_used"], seed=seed, iterations=iterations, nodes=nodes,
+        cost_deg=cost if ok else None, wall_s=wall, path_deg=path, tree_nodes_deg=tree_nodes,
+        tree_parent=tree_parent, work=work, rulebook=template["rulebook"],
+        rulebook_sha256=template["rulebook_sha256"], params=params)
+
+
+_new_object = object.__new__
+
+
 _path_check = None
 
 

@@ -11,7 +11,6 @@ Fuzzy-RRT: every sample counts, accepted or not.
 
 from __future__ import annotations
 
-import functools
 import time
 from typing import Any, NamedTuple
 
@@ -22,7 +21,8 @@ from xfuzzy_rrt.geometry.scenario import Scenario
 from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.params import default
-from xfuzzy_rrt.planners.result import GOAL_REACHED, PlanResult, certified_result, finished_tree
+from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, bound_result, certified_result,
+                                       certified_template, finished_tree)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
@@ -101,6 +101,8 @@ class _Setup(NamedTuple):
     #: the problem in one block (:mod:`~xfuzzy_rrt.planners.problem_arena`)
     problem: Any
     recorded: dict
+    #: ``(scenario name, label, extra params)`` -> the run :func:`_lane` made for this set-up
+    lanes: dict
 
 
 def _prepare(scenario: Scenario, max_iter, step_deg, goal_bias, margin, clearance_m,
@@ -112,7 +114,7 @@ def _prepare(scenario: Scenario, max_iter, step_deg, goal_bias, margin, clearanc
     a = scenario_arrays(scenario)
     recorded = {"step_deg": float(params["step_deg"]), "goal_bias": float(params["goal_bias"]),
                 "max_iter": int(params["max_iter"]), "margin_m": float(margin)}
-    return _Setup(a, margin, params, make_problem_arena(a.problem(margin)), recorded)
+    return _Setup(a, margin, params, make_problem_arena(a.problem(margin)), recorded, {})
 
 
 def _setup_for(scenario: Scenario, max_iter, step_deg, goal_bias, margin,
@@ -156,15 +158,59 @@ def bind_rrt_as(label: str, extra_params: dict | None, scenario: Scenario, *, ma
                 step_deg, goal_bias, clearance_m):
     """:func:`plan_rrt_as` without a time budget, for every seed: ``run(seed) -> PlanResult``,
     the same result (what ``plan_scenario`` keeps for a loop of calls: ``api._LANES``)."""
-    return functools.partial(_run, _setup_for(scenario, max_iter, step_deg, goal_bias, None,
-                                              clearance_m), scenario.name, label,
-                             extra_params)
+    return _lane(_setup_for(scenario, max_iter, step_deg, goal_bias, None, clearance_m),
+                 scenario.name, label, extra_params)
+
+
+def _lane(setup: _Setup, name: str, label: str, extra_params: dict | None):
+    """The run of ``setup`` without a time budget, ``run(seed) -> PlanResult``, made once per
+    set-up, scenario name, label and extra params (``setup.lanes``; the same result as
+    :func:`_run`'s general path, tests/test_plan_lanes.py): the twin of
+    :func:`xfuzzy_rrt.planners.connect._lane`, so that ``rrt:tuned`` sheds the same Python
+    as the default (why: :func:`~xfuzzy_rrt.planners.result.bound_result`)."""
+    key = (name, label, None if extra_params is None else tuple(extra_params.items()))
+    try:
+        run = setup.lanes.get(key)
+    except TypeError:  # extra params that cannot be a key: a run made for this call only
+        key, run = None, None
+    if run is not None:
+        return run
+    a, params = setup.arrays, setup.params
+    pblock, playout = setup.problem
+    max_iter = int(params["max_iter"])
+    step, bias = float(params["step_deg"]), float(params["goal_bias"])
+    tree_key = (max_iter + 2, a.limits_deg, a.stop_width)
+    recorded = dict(setup.recorded) if extra_params is None else {**setup.recorded,
+                                                                   **extra_params}
+    margin = float(setup.margin)
+    template = certified_template(
+        scenario=name, planner=label, planner_used=label, seed=0, iterations=0, nodes=0,
+        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
+        work=0, params=None)
+    clock = time.perf_counter
+
+    def run(seed):
+        arena = pooled_tree(*tree_key)
+        t0 = clock()
+        ok, iterations, _, n, nodes, parents, path, cost, within, work = rrt_entry(
+            pblock, playout, arena.block, arena.layout, seed, max_iter, step, bias,
+            NEVER_STOPPED)
+        wall = clock() - t0
+        return bound_result(template, a, margin, ok, within, seed, iterations, n, cost, wall,
+                            path, nodes, parents, work, dict(recorded))
+
+    if key is not None:
+        setup.lanes[key] = run
+    return run
 
 
 def _run(setup: _Setup, name: str, label: str, extra_params: dict | None, seed,
          max_time_s=None) -> PlanResult:
     """One run of a checked set-up (:func:`plan_rrt_as`) of the scenario called ``name`` (the
-    name, not the scenario: a kept run must not keep its scenario alive)."""
+    name, not the scenario: a kept run must not keep its scenario alive). Without a time
+    budget: :func:`_lane`'s run."""
+    if max_time_s is None:
+        return _lane(setup, name, label, extra_params)(int(seed))
     a, margin, params = setup.arrays, setup.margin, setup.params
     max_iter = int(params["max_iter"])
     pblock, playout = setup.problem
@@ -172,21 +218,16 @@ def _run(setup: _Setup, name: str, label: str, extra_params: dict | None, seed,
     block, layout = arena.block, arena.layout
     step, bias = float(params["step_deg"]), float(params["goal_bias"])
     recorded = dict(setup.recorded)
-    if max_time_s is None:
+    # the budget is for planning: compile (or load) the kernel first
+    rrt_entry(pblock, playout, block, layout, int(seed), 0, step, bias,
+              np.zeros(1, dtype=np.int64))
+    with StopFlag(max_time_s) as flag:
         t0 = time.perf_counter()
         ok, iterations, _, n, nodes, parents, path, cost, within, work = rrt_entry(
-            pblock, playout, block, layout, int(seed), max_iter, step, bias, NEVER_STOPPED)
+            pblock, playout, block, layout, int(seed), max_iter, step, bias, flag.array)
         wall = time.perf_counter() - t0
-    else:  # the budget is for planning: compile (or load) the kernel first
-        rrt_entry(pblock, playout, block, layout, int(seed), 0, step, bias,
-                  np.zeros(1, dtype=np.int64))
-        with StopFlag(max_time_s) as flag:
-            t0 = time.perf_counter()
-            ok, iterations, _, n, nodes, parents, path, cost, within, work = rrt_entry(
-                pblock, playout, block, layout, int(seed), max_iter, step, bias, flag.array)
-            wall = time.perf_counter() - t0
-        recorded["max_time_s"] = float(params["max_time_s"])
-        recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
+    recorded["max_time_s"] = float(params["max_time_s"])
+    recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
     return certified_result(
         a, margin, bool(ok), edges_certified=True, within_limits=within,
         scenario=name, planner=label, planner_used=label, seed=int(seed),

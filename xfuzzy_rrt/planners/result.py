@@ -440,11 +440,12 @@ def bound_result(template: dict[str, Any], arrays, margin: float, ok: bool, with
     **fields)`` for a compiled planner's run, the fixed fields taken from ``template``
     (:func:`certified_template`) and the run's own passed by position.
 
-    Why: a run kept for a loop of calls (``api._LANES``; every untraced call without a time
-    budget) spent more Python on its result than on its search when the caches are cold: the
-    keyword call, ``asarray``, the field checks of :func:`_certified` and the conversions cost
-    ~80 us of a 3-joint call of ~300 us, for every compiled planner alike (docs/peer-measurements.md,
-    twenty-third session). A certified path (found, every vertex within the limits, every edge
+    Why: with the caches cold (``evaluate``'s default; a plan between other work) a run spent
+    as much Python around its compiled call as in it: the general path's keyword calls,
+    ``asarray``, the field checks of :func:`_certified` and the conversions. Made once per
+    set-up and label instead (the planners' ``_lane``), and filled here, a cold call of the
+    default or ``rrt:tuned`` costs 40-60 us less of ~300 us at 3 joints and ~50 us of ~230 at
+    2 (docs/peer-measurements.md, twenty-third session). A certified path (found, every vertex within the limits, every edge
     certified by the kernel) copies the template and sets the run's fields; anything else (a
     failure) goes through :func:`certified_result` itself. The values are the ones the kernel
     returned: Python ``int``/``bool``/``float`` already (numba boxes them so), as the general

@@ -445,9 +445,9 @@ def bound_result(template: dict[str, Any], arrays, margin: float, ok: bool, with
     ``asarray``, the field checks of :func:`_certified` and the conversions. Made once per
     set-up and label instead (the planners' ``_lane``), and filled here, a cold call of the
     default or ``rrt:tuned`` costs 40-60 us less of ~300 us at 3 joints and ~50 us of ~230 at
-    2 (docs/peer-measurements.md, twenty-third session). A certified path (found, every vertex within the limits, every edge
-    certified by the kernel) copies the template and sets the run's fields; anything else (a
-    failure) goes through :func:`certified_result` itself. The values are the ones the kernel
+    2 (docs/peer-measurements.md, twenty-third session). A certified path (found, every vertex
+    within the limits, every edge certified by the kernel) copies the template and sets the
+    run's fields; anything else (a failure) goes through :func:`certified_result` itself. The values are the ones the kernel
     returned: Python ``int``/``bool``/``float`` already (numba boxes them so), as the general
     path's ``int()``/``bool()`` leave them."""
     if ok and within and path.shape[0] >= 2:

@@ -91,7 +91,6 @@ from xfuzzy_rrt.planners.result import (
     NODE_IN_COLLISION,
     PlanResult,
     bound_result,
-    certified_result,
     certified_template,
     path_cost_compiled,
     replace_result,
@@ -499,6 +498,16 @@ def bind_fuzzy_rrt_connect(scenario: Scenario, rulebook, *, max_iter, clearance_
                  scenario.name, label)
 
 
+def _template(name: str, label: str, rb) -> dict:
+    """The fields of a run that the run does not change (the scenario's name, the label, the
+    rulebook): :func:`~xfuzzy_rrt.planners.result.bound_result`'s template, the one list for
+    :func:`_lane` and :func:`_run`'s general path."""
+    return certified_template(
+        scenario=name, planner=label, planner_used=PLANNER, seed=0, iterations=0, nodes=0,
+        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
+        rulebook=rb.name, rulebook_sha256=rb.sha256, params=None, work=0)
+
+
 def _lane(setup: _Setup, name: str, label: str):
     """The untraced run of ``setup`` without a time budget, ``run(seed) -> PlanResult``, made
     once per set-up, scenario name and label (``setup.lanes``): everything a run reads is
@@ -514,10 +523,7 @@ def _lane(setup: _Setup, name: str, label: str):
                                                 setup.min_step, setup.max_iter)
     trees_key = (setup.capacity, a.limits_deg, 2, a.stop_width)
     recorded, margin = setup.recorded, float(setup.margin)
-    template = certified_template(
-        scenario=name, planner=label, planner_used=PLANNER, seed=0, iterations=0, nodes=0,
-        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
-        rulebook=rb.name, rulebook_sha256=rb.sha256, params=None, work=0)
+    template = _template(name, label, rb)
     clock = time.perf_counter
 
     def run(seed):
@@ -585,18 +591,10 @@ def _run(setup: _Setup, name: str, label: str, seed, trace=False,
     if max_time_s is not None:
         recorded["max_time_s"] = float(setup.params["max_time_s"])
         recorded["stopped_by"] = stopped_by(ok, int(iterations), max_iter, flag)
-    result = certified_result(
-        a, margin, ok, scenario=name, planner=label, planner_used=PLANNER,
-        seed=int(seed),
-        iterations=int(iterations), nodes=na + nb_,
-        cost_deg=cost if ok else None, wall_s=wall, path_deg=path,
-        tree_nodes_deg=nodes, tree_parent=parent, rulebook=rb.name,
-        rulebook_sha256=rb.sha256, params=recorded,
-        work=int(work),
-        # every path segment is a tree edge the kernel certified with edge_free at this margin
-        # (the goal tree's, traversed backwards: the same set of configurations)
-        edges_certified=True, within_limits=within,
-    )
+    # every path segment is a tree edge the kernel certified with edge_free at this margin (the
+    # goal tree's, traversed backwards: the same set of configurations)
+    result = bound_result(_template(name, label, rb), a, margin, ok, within, int(seed),
+                          iterations, na + nb_, cost, wall, path, nodes, parent, work, recorded)
     if trace:
         frame = _trace_frame(buffers, grown, connect_nodes, int(iterations), nodes, parent, na,
                              int(last_a), int(last_b) + na if ok else -1, rb, min_step, scale)

@@ -438,18 +438,19 @@ def bound_result(template: dict[str, Any], arrays, margin: float, ok: bool, with
                  tree_nodes, tree_parent, work: int, params: dict) -> PlanResult:
     """``certified_result(arrays, margin, ok, edges_certified=True, within_limits=within,
     **fields)`` for a compiled planner's run, the fixed fields taken from ``template``
-    (:func:`certified_template`) and the run's own passed by position.
+    (:func:`certified_template`) and the run's own passed by position. Every run of RRT,
+    Fuzzy-RRT and Fuzzy-RRT-Connect ends here (the planners' ``_lane`` and ``_run``), so the
+    fields a run does not change are listed once per planner (its ``_template``).
 
     Why: with the caches cold (``evaluate``'s default; a plan between other work) a run spent
-    as much Python around its compiled call as in it: the general path's keyword calls,
-    ``asarray``, the field checks of :func:`_certified` and the conversions. Made once per
-    set-up and label instead (the planners' ``_lane``), and filled here, a cold call of the
-    default or ``rrt:tuned`` costs 40-60 us less of ~300 us at 3 joints and ~50 us of ~230 at
-    2 (docs/peer-measurements.md, twenty-third session). A certified path (found, every vertex
-    within the limits, every edge certified by the kernel) copies the template and sets the
-    run's fields; anything else (a failure) goes through :func:`certified_result` itself. The values are the ones the kernel
-    returned: Python ``int``/``bool``/``float`` already (numba boxes them so), as the general
-    path's ``int()``/``bool()`` leave them."""
+    as much Python around its compiled call as in it: keyword calls, ``asarray``, the field
+    checks of :func:`_certified` and the conversions. With the template made once per set-up
+    and label (``_lane``) and filled here, a cold call of the default or ``rrt:tuned`` costs
+    40-60 us less of ~300 us at 3 joints and ~50 us of ~230 at 2 (docs/peer-measurements.md,
+    twenty-third session). A certified path (found, every vertex within the limits, every
+    edge certified by the kernel) copies the template and sets the run's fields; anything else
+    (a failure) goes through :func:`certified_result` itself. The values are the ones the
+    kernel returned: Python ``int``/``bool``/``float`` already (numba boxes them so)."""
     if ok and within and path.shape[0] >= 2:
         result = _new_object(PlanResult)
         d = result.__dict__

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from xfuzzy_rrt.planners import tree_arena
-from xfuzzy_rrt.planners.tree import TreeArrays, make_tree
+from xfuzzy_rrt.planners.tree import TreeArrays, add_node, make_tree
 from xfuzzy_rrt.planners.tree_arena import emptied_tree_in, make_tree_arena, tree_in
 
 
@@ -42,16 +42,25 @@ def test_compiled_code_sees_the_arena_fields_with_the_types_of_separate_arrays(d
     assert nb.typeof(make_tree(300, _limits(dof))) in compiled
 
 
-def test_the_compiled_entries_empty_a_used_tree():
-    arena = make_tree_arena(200, _limits(2))
-    arena.tree.meta[:] = 7
-    arena.tree.cell_head[:] = 3
-    arena.tree.occ[:] = 1
-    emptied_tree_in(arena.block, arena.layout)
-    fresh = make_tree(200, _limits(2))
-    np.testing.assert_array_equal(arena.tree.meta, fresh.meta)
-    np.testing.assert_array_equal(arena.tree.cell_head, fresh.cell_head)
-    np.testing.assert_array_equal(arena.tree.occ, fresh.occ)
+@pytest.mark.parametrize("spread", [0.0, 5.0, 60.0, 400.0])
+@pytest.mark.parametrize("dof", [2, 3])
+def test_the_compiled_entries_empty_a_used_tree(dof, spread):
+    """However many cells a run filled (one; a corner of the grid; all of it, nodes beyond the
+    limits clamped into the edge cells), the emptied tree is a new tree: every grid cell and
+    occupied bit cleared, run after run of the same pooled tree."""
+    rng = np.random.default_rng(int(spread) + dof)
+    arena = make_tree_arena(400, _limits(dof))
+    fresh = make_tree(400, _limits(dof))
+    for _ in range(3):  # runs of the same pooled tree, emptied between them
+        centre = rng.uniform(-180.0, 180.0, dof)
+        for i in range(int(rng.integers(1, 400))):
+            add_node(arena.tree, centre + rng.uniform(-spread, spread, dof), i - 1)
+        if dof == 2 and spread > 0.0:
+            assert (arena.tree.cell_head >= 0).sum() > 1 and arena.tree.occ.any()
+        emptied_tree_in(arena.block, arena.layout)
+        for name in ("meta", "cell_head", "occ"):
+            np.testing.assert_array_equal(getattr(arena.tree, name), getattr(fresh, name),
+                                          err_msg=name)
 
 
 def test_an_arena_refuses_a_tree_whose_fields_changed_kind(monkeypatch):

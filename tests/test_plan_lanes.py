@@ -200,8 +200,8 @@ def _same_but_the_budget(lane, general) -> None:
 @pytest.mark.parametrize("max_iter", [10_000, 2])
 def test_a_lane_builds_the_result_the_general_path_builds(problems, fresh, planner, loader,
                                                           max_iter):
-    """The lanes copy a template instead of calling ``certified_result`` (result.bound_result):
-    found or not, their results are the general path's, field for field."""
+    """A lane (its template made once, its entry called its own way) gives the general path's
+    result (the time-budgeted run), found or not, field for field."""
     rulebook = loader()
     found = []
     for scenario in problems:
@@ -216,3 +216,36 @@ def test_a_lane_builds_the_result_the_general_path_builds(problems, fresh, plann
     assert any(k[0] == planner for k in api._LANES)
     # both branches of bound_result: every run found with room, some not with two iterations
     assert all(found) if max_iter > 2 else not all(found)
+
+
+@pytest.mark.parametrize("found", [True, False])
+def test_a_result_filled_from_a_template_is_certified_results_own(problems, found):
+    """Every compiled planner's run ends in ``bound_result`` (lanes, traces and budgets alike),
+    so it is checked here against ``certified_result`` itself, the other way every planner's
+    result is made: the same fields, the same instance entries, the same deferred clearance."""
+    from xfuzzy_rrt.planners.prepared import scenario_arrays
+    from xfuzzy_rrt.planners.result import bound_result, certified_result, certified_template
+
+    scenario = problems[1]
+    run = plan_scenario(scenario, "rrt", seed=3, max_iter=10_000 if found else 2)
+    assert run.found is found
+    arrays, margin = scenario_arrays(scenario), float(run.params["margin_m"])
+    fixed = dict(scenario=scenario.name, planner="a-label", planner_used="a-planner",
+                 rulebook="a-rulebook", rulebook_sha256="ab" * 32)
+    template = certified_template(seed=0, iterations=0, nodes=0, cost_deg=None, wall_s=0.0,
+                                  path_deg=None, tree_nodes_deg=None, tree_parent=None, work=0,
+                                  params=None, **fixed)
+    params = {"max_iter": 17, "margin_m": margin}
+    got = bound_result(template, arrays, margin, found, True, 11, 17, 23, 123.25, 0.5,
+                       run.path_deg, run.tree_nodes_deg, run.tree_parent, 999, dict(params))
+    want = certified_result(arrays, margin, found, edges_certified=True, within_limits=True,
+                            seed=11, iterations=17, nodes=23,
+                            cost_deg=123.25 if found else None, wall_s=0.5,
+                            path_deg=run.path_deg, tree_nodes_deg=run.tree_nodes_deg,
+                            tree_parent=run.tree_parent, work=999, params=dict(params),
+                            **fixed)
+    _same(got, want)
+    assert got.wall_s == want.wall_s and got.params == want.params
+    assert set(got.__dict__) == set(want.__dict__)
+    assert got.min_clearance_m == want.min_clearance_m
+    assert got.penetration_m == want.penetration_m

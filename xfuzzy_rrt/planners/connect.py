@@ -91,8 +91,8 @@ from xfuzzy_rrt.planners.result import (
     NODE_IN_COLLISION,
     PlanResult,
     bound_result,
-    certified_template,
     path_cost_compiled,
+    planner_template,
     replace_result,
     vertices_within,
 )
@@ -498,16 +498,6 @@ def bind_fuzzy_rrt_connect(scenario: Scenario, rulebook, *, max_iter, clearance_
                  scenario.name, label)
 
 
-def _template(name: str, label: str, rb) -> dict:
-    """The fields of a run that the run does not change (the scenario's name, the label, the
-    rulebook): :func:`~xfuzzy_rrt.planners.result.bound_result`'s template, the one list for
-    :func:`_lane` and :func:`_run`'s general path."""
-    return certified_template(
-        scenario=name, planner=label, planner_used=PLANNER, seed=0, iterations=0, nodes=0,
-        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
-        rulebook=rb.name, rulebook_sha256=rb.sha256, params=None, work=0)
-
-
 def _lane(setup: _Setup, name: str, label: str):
     """The untraced run of ``setup`` without a time budget, ``run(seed) -> PlanResult``, made
     once per set-up, scenario name and label (``setup.lanes``): everything a run reads is
@@ -523,7 +513,7 @@ def _lane(setup: _Setup, name: str, label: str):
                                                 setup.min_step, setup.max_iter)
     trees_key = (setup.capacity, a.limits_deg, 2, a.stop_width)
     recorded, margin = setup.recorded, float(setup.margin)
-    template = _template(name, label, rb)
+    template = planner_template(name, label, PLANNER, rb)
     clock = time.perf_counter
 
     def run(seed):
@@ -593,8 +583,9 @@ def _run(setup: _Setup, name: str, label: str, seed, trace=False,
         recorded["stopped_by"] = stopped_by(ok, int(iterations), max_iter, flag)
     # every path segment is a tree edge the kernel certified with edge_free at this margin (the
     # goal tree's, traversed backwards: the same set of configurations)
-    result = bound_result(_template(name, label, rb), a, margin, ok, within, int(seed),
-                          iterations, na + nb_, cost, wall, path, nodes, parent, work, recorded)
+    result = bound_result(planner_template(name, label, PLANNER, rb), a, margin, ok, within,
+                          int(seed), iterations, na + nb_, cost, wall, path, nodes, parent, work,
+                          recorded)
     if trace:
         frame = _trace_frame(buffers, grown, connect_nodes, int(iterations), nodes, parent, na,
                              int(last_a), int(last_b) + na if ok else -1, rb, min_step, scale)

@@ -66,7 +66,7 @@ from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.goal_frame import goal_frame_kernel
 from xfuzzy_rrt.planners.params import default
 from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, bound_result,
-                                       certified_template, finished_tree, replace_result)
+                                       finished_tree, planner_template, replace_result)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.trace_record import (
@@ -418,16 +418,6 @@ def bind_fuzzy_rrt(scenario: Scenario, rulebook, *, max_iter, clearance_m, label
                  scenario.name, label)
 
 
-def _template(name: str, label: str, rb) -> dict:
-    """The fields of a run that the run does not change (the scenario's name, the label, the
-    rulebook): :func:`~xfuzzy_rrt.planners.result.bound_result`'s template, the one list for
-    :func:`_lane` and :func:`_run`'s general path."""
-    return certified_template(
-        scenario=name, planner=label, planner_used="fuzzy-rrt", seed=0, iterations=0, nodes=0,
-        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
-        work=0, rulebook=rb.name, rulebook_sha256=rb.sha256, params=None)
-
-
 def _lane(setup: _Setup, name: str, label: str):
     """The untraced run of ``setup`` without a time budget, ``run(seed) -> PlanResult``, made
     once per set-up, scenario name and label (``setup.lanes``; the same result as
@@ -443,7 +433,7 @@ def _lane(setup: _Setup, name: str, label: str):
     pblock, playout = setup.problem
     tree_key = (max_iter + 2, a.limits_deg, a.stop_width)
     recorded, margin = setup.recorded, float(setup.margin)
-    template = _template(name, label, rb)
+    template = planner_template(name, label, "fuzzy-rrt", rb)
     clock = time.perf_counter
 
     def run(seed):
@@ -493,8 +483,9 @@ def _run(setup: _Setup, name: str, label: str, seed, trace=False,
         recorded["max_time_s"] = float(setup.params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
     # certifies the path (found -> success)
-    result = bound_result(_template(name, label, rb), a, margin, ok, within, int(seed),
-                          iterations, n, cost, wall, path, nodes, parents, work, recorded)
+    result = bound_result(planner_template(name, label, "fuzzy-rrt", rb), a, margin, ok, within,
+                          int(seed), iterations, n, cost, wall, path, nodes, parents, work,
+                          recorded)
     if trace:
         from xfuzzy_rrt.planners.trace import trace_frame
 

@@ -433,6 +433,19 @@ def certified_template(**fields: Any) -> dict[str, Any]:
     return dict(_certified(fields).__dict__)
 
 
+def planner_template(name: str, label: str, planner_used: str, rulebook=None) -> dict[str, Any]:
+    """:func:`certified_template` for a run of a compiled planner: the fields a run does not
+    change (the scenario's name, the label, the planner that ran, the rulebook if any) set,
+    the run's own as placeholders for :func:`bound_result`. One list for every planner's kept
+    runs and general path alike."""
+    named = {} if rulebook is None else {"rulebook": rulebook.name,
+                                         "rulebook_sha256": rulebook.sha256}
+    return certified_template(
+        scenario=name, planner=label, planner_used=planner_used, seed=0, iterations=0, nodes=0,
+        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
+        work=0, params=None, **named)
+
+
 def bound_result(template: dict[str, Any], arrays, margin: float, ok: bool, within: bool,
                  seed: int, iterations: int, nodes: int, cost: float, wall: float, path,
                  tree_nodes, tree_parent, work: int, params: dict) -> PlanResult:
@@ -440,7 +453,7 @@ def bound_result(template: dict[str, Any], arrays, margin: float, ok: bool, with
     **fields)`` for a compiled planner's run, the fixed fields taken from ``template``
     (:func:`certified_template`) and the run's own passed by position. Every run of RRT,
     Fuzzy-RRT and Fuzzy-RRT-Connect ends here (the planners' ``_lane`` and ``_run``), so the
-    fields a run does not change are listed once per planner (its ``_template``).
+    fields a run does not change are listed once (:func:`planner_template`).
 
     Why: with the caches cold (``evaluate``'s default; a plan between other work) a run spent
     as much Python around its compiled call as in it: keyword calls, ``asarray``, the field

@@ -22,7 +22,7 @@ from xfuzzy_rrt.planners.checks import check_plan_call
 from xfuzzy_rrt.planners.extend import extend, join_start_at_goal
 from xfuzzy_rrt.planners.params import default
 from xfuzzy_rrt.planners.result import (GOAL_REACHED, PlanResult, bound_result,
-                                       certified_template, finished_tree)
+                                       finished_tree, planner_template)
 from xfuzzy_rrt.planners.rng import seed_state, uniform
 from xfuzzy_rrt.planners.termination import NEVER_STOPPED, StopFlag, stopped_by
 from xfuzzy_rrt.planners.prepared import pooled_tree, scenario_arrays
@@ -162,16 +162,6 @@ def bind_rrt_as(label: str, extra_params: dict | None, scenario: Scenario, *, ma
                  scenario.name, label, extra_params)
 
 
-def _template(name: str, label: str) -> dict:
-    """The fields of a run that the run does not change (the scenario's name, the label):
-    :func:`~xfuzzy_rrt.planners.result.bound_result`'s template, the one list for
-    :func:`_lane` and :func:`_run`'s general path."""
-    return certified_template(
-        scenario=name, planner=label, planner_used=label, seed=0, iterations=0, nodes=0,
-        cost_deg=None, wall_s=0.0, path_deg=None, tree_nodes_deg=None, tree_parent=None,
-        work=0, params=None)
-
-
 def _lane(setup: _Setup, name: str, label: str, extra_params: dict | None):
     """The run of ``setup`` without a time budget, ``run(seed) -> PlanResult``, made once per
     set-up, scenario name, label and extra params (``setup.lanes``; the same result as
@@ -193,7 +183,7 @@ def _lane(setup: _Setup, name: str, label: str, extra_params: dict | None):
     recorded = dict(setup.recorded) if extra_params is None else {**setup.recorded,
                                                                    **extra_params}
     margin = float(setup.margin)
-    template = _template(name, label)
+    template = planner_template(name, label, label)
     clock = time.perf_counter
 
     def run(seed):
@@ -235,6 +225,6 @@ def _run(setup: _Setup, name: str, label: str, extra_params: dict | None, seed,
         wall = time.perf_counter() - t0
     recorded["max_time_s"] = float(params["max_time_s"])
     recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)
-    return bound_result(_template(name, label), a, margin, ok, within, int(seed), iterations,
-                        n, cost, wall, path, nodes, parents, work,
+    return bound_result(planner_template(name, label, label), a, margin, ok, within, int(seed),
+                        iterations, n, cost, wall, path, nodes, parents, work,
                         recorded if extra_params is None else {**recorded, **extra_params})

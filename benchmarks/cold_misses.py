@@ -1,15 +1,15 @@
 """Cold calls counted, not timed: simulated cache misses per planner call under callgrind.
 
-Why: a call made between other work starts with its code and data out of the caches, and
-there its cost is mostly last-level misses (a cold 2-joint call of ``rrt:tuned`` here: ~2,100
-misses and ~100 us, ~50 ns each). Timing that is noisy on a shared machine: the same script
-and code gave 95-113 us one hour and 146-490 us the next (docs/peer-measurements.md,
-twenty-fifth session), so a change worth 1-3 us could not be decided. Callgrind's cache
-simulator counts the same misses on every run, whatever the machine's state: this script
-calls each planner on the given problems as ``benchmarks/cold_calls.py`` does, with the
-simulated caches evicted before every call, and prints per call the instructions (Ir), the
-simulated last-level misses for code (ILmr) and data (DLmr read, DLmw write) and their sum,
-and each planner's misses over the first one's.
+Why: a call made between other work starts with its code and data out of the caches, and there
+its cost is mostly last-level misses (``rrt:tuned``'s compiled 2-joint entry with no iteration,
+cold: ~2,100 misses and ~100 us, ~50 ns each). Timing that is noisy on a shared machine: the
+same script and code gave 95-113 us one hour and 146-490 us the next
+(docs/peer-measurements.md, twenty-fifth session), so a change worth 1-3 us could not be
+decided. Callgrind's cache simulator counts the same misses on every run (within 0.1 %),
+whatever the machine's state: this script calls each planner on the given problems as
+``benchmarks/cold_calls.py`` does, with the simulated caches evicted before every call, and
+prints per call the instructions (Ir), the simulated last-level misses for code (ILmr) and data
+(DLmr read, DLmw write) and their sum, and each planner's misses over the first one's.
 
 How: each planner runs in its own process under ``valgrind --tool=callgrind`` with
 instrumentation off while Python starts and the kernels load, then on (a few lines of C,
@@ -25,7 +25,7 @@ run takes 10-30 s per planner here, two planners at a time. Run on problems nobo
     python benchmarks/cold_misses.py /tmp/eval-dual3 --planner fuzzy-rrt --planner rrt:tuned
 
 To compare two versions of the code, run it from each checkout (``PYTHONPATH``) and compare
-the per-call counts: they are the same on every run of the same code.
+the per-call counts: they are the same (within 0.1 %) on every run of the same code.
 """
 
 from __future__ import annotations

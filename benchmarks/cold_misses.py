@@ -18,8 +18,11 @@ call a 16 MB array is written (twice the simulated 8 MB last level), and only th
 is collected. The whole ``plan_scenario`` call is counted (set-up memo, kernel, result), with
 each planner's rulebooks or settings loaded once, as ``evaluate`` calls it. What it does not
 model: the TLB, the branch predictor and prefetching (sequential code misses cost less than
-scattered data ones). Needs ``valgrind`` and a C compiler with ``valgrind/callgrind.h``; a
-run takes 10-30 s per planner here, two planners at a time. Run on problems nobody tuned on::
+scattered data ones). The code counted is what numba compiles for the CPU that valgrind
+presents (no AVX-512), not the host's: numba keys its cache on the CPU, so the first run on a
+machine compiles every kernel under valgrind (10-20 minutes) and later runs take 10-30 s per
+planner, two planners at a time. Needs ``valgrind`` and a C compiler with
+``valgrind/callgrind.h``. Run on problems nobody tuned on::
 
     python benchmarks/cold_misses.py /tmp/eval-sample --problems 8 --seeds 3
     python benchmarks/cold_misses.py /tmp/eval-dual3 --planner fuzzy-rrt --planner rrt:tuned
@@ -109,11 +112,21 @@ def count(helper: Path, planner: str, files: list[Path], seeds: int, max_iter: i
     if done.returncode != 0 or not dumps:
         tail = "\n".join(done.stderr.strip().splitlines()[-5:])
         raise SystemExit(f"cold_misses: the callgrind run of {planner} failed:\n{tail}")
-    summary = next(line for line in dumps[-1].read_text().splitlines()
-                   if line.startswith("summary:"))
-    values = dict(zip(EVENTS, map(int, summary.split()[1:])))
-    calls = len(files) * seeds
-    return {"planner": planner, "calls": calls, **{k: v / calls for k, v in values.items()},
+    return {"planner": planner, **per_call(dumps[-1].read_text(), len(files) * seeds)}
+
+
+def per_call(dump: str, calls: int) -> dict[str, float]:
+    """The events of a callgrind dump (its ``events:`` and ``summary:`` lines) divided by the
+    ``calls`` it collected, with ``LL`` the sum of the last-level misses."""
+    lines = dump.splitlines()
+    names = next(line for line in lines if line.startswith("events:")).split()[1:]
+    values = dict(zip(names, map(int, next(line for line in lines
+                                           if line.startswith("summary:")).split()[1:])))
+    missing = [e for e in EVENTS if e not in values]
+    if missing:
+        raise SystemExit(f"cold_misses: the dump has no {', '.join(missing)} (cache simulation "
+                         "off?)")
+    return {"calls": calls, **{e: values[e] / calls for e in EVENTS},
             "LL": (values["ILmr"] + values["DLmr"] + values["DLmw"]) / calls}
 
 

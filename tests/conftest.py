@@ -83,6 +83,18 @@ def run_main(*args, cwd: str | os.PathLike[str] | None = None,
                                        text(raw_err))
 
 
+def load_script(relative: str):
+    """The module of a project script that is not in the package (``benchmarks/NAME.py``,
+    ``scripts/NAME.py``), loaded from its file, so tests can call its functions."""
+    import importlib.util
+
+    path = PROJECT / relative
+    spec = importlib.util.spec_from_file_location(path.stem + "_script", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def shared_scenarios() -> list[Path]:
     """The shared scenario files when ``../shared/scenarios`` is present, else empty."""
     if not SHARED_SCENARIOS.is_dir():

@@ -3,12 +3,12 @@ how it summarises (its figures are timings, reported in the README, never assert
 
 from __future__ import annotations
 
-import importlib.util
 import math
 from pathlib import Path
 
 import pytest
 
+from conftest import load_script
 from xfuzzy_rrt.geometry.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -17,11 +17,7 @@ DEMO = ROOT / "xfuzzy_rrt" / "data" / "scenarios" / "demo-gap.toml"
 
 @pytest.fixture(scope="module")
 def ceiling():
-    spec = importlib.util.spec_from_file_location("ceiling_bench", ROOT / "benchmarks" /
-                                                  "ceiling.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("benchmarks/ceiling.py")
 
 
 def test_the_ceiling_is_the_tuned_call_over_the_floor_and_counts_problems_below_2x(ceiling):

@@ -8,7 +8,6 @@ than the host (no AVX-512), so the first run on a machine compiles every kernel 
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import shutil
 import tempfile
@@ -16,17 +15,14 @@ from pathlib import Path
 
 import pytest
 
+from conftest import load_script
 ROOT = Path(__file__).resolve().parents[1]
 DEMO = ROOT / "xfuzzy_rrt" / "data" / "scenarios" / "demo-gap.toml"
 
 
 @pytest.fixture(scope="module")
 def cold_misses():
-    spec = importlib.util.spec_from_file_location("cold_misses_bench", ROOT / "benchmarks" /
-                                                  "cold_misses.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("benchmarks/cold_misses.py")
 
 
 DUMP = """version: 1

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from conftest import FIXTURES, run_main
+from conftest import FIXTURES, load_script, run_main
 from xfuzzy_rrt.bench.protocol import problem_table, run_protocol, summary_table
 from xfuzzy_rrt.fuzzy.rulebook import load_rulebook
 from xfuzzy_rrt.geometry.scenario import load_scenario
@@ -103,12 +103,7 @@ def test_evaluate_prints_the_fastest_peer_table_from_its_own_summary(tmp_path):
 
 
 def test_the_best_peer_script_refuses_a_folder_without_runs_in_one_line(tmp_path, capsys):
-    import importlib.util
-
-    path = FIXTURES.parents[1] / "scripts" / "best_peer.py"
-    spec = importlib.util.spec_from_file_location("best_peer", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_script("scripts/best_peer.py")
     assert module.main(str(tmp_path)) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(tmp_path) in err[0] and "runs.csv" in err[0]

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import load_script
 from xfuzzy_rrt.bench.interval import median_interval, median_ratio_interval
 from xfuzzy_rrt.bench.protocol import problem_table, summary_table
 
@@ -99,14 +100,7 @@ def test_without_peers_the_interval_columns_are_empty(table):
 
 
 def _noise_floor_script():
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[1] / "scripts" / "noise_floor.py"
-    spec = importlib.util.spec_from_file_location("noise_floor", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("scripts/noise_floor.py")
 
 
 def test_the_noise_floor_compares_a_planners_even_seeds_with_its_odd_ones():

@@ -20,9 +20,9 @@ each planner's rulebooks or settings loaded once, as ``evaluate`` calls it. What
 model: the TLB, the branch predictor and prefetching (sequential code misses cost less than
 scattered data ones). The code counted is what numba compiles for the CPU that valgrind
 presents (no AVX-512), not the host's: numba keys its cache on the CPU, so the first run on a
-machine compiles every kernel under valgrind (10-20 minutes) and later runs take 10-30 s per
-planner, two planners at a time. Needs ``valgrind`` and a C compiler with
-``valgrind/callgrind.h``. Run on problems nobody tuned on::
+machine compiles every kernel under valgrind (several minutes: over 5 in a CI run, which was
+stopped) and later runs take 10-30 s per planner, two planners at a time. Needs ``valgrind``
+and a C compiler with ``valgrind/callgrind.h``. Run on problems nobody tuned on::
 
     python benchmarks/cold_misses.py /tmp/eval-sample --problems 8 --seeds 3
     python benchmarks/cold_misses.py /tmp/eval-dual3 --planner fuzzy-rrt --planner rrt:tuned

@@ -4,7 +4,7 @@ the same code gives the same counts. Its figures go in the measurement log, neve
 
 Why the second is opt-in: numba keys its cache on the CPU, and valgrind presents another one
 than the host (no AVX-512), so the first run on a machine compiles every kernel under valgrind,
-10-20 minutes that a clean checkout's CI would spend on one test."""
+several minutes (over 5 in a CI run) that a clean checkout's CI would spend on one test."""
 
 from __future__ import annotations
 

@@ -145,24 +145,53 @@ def measure(files: list[Path], planners: list[str], seeds: int = 3,
                                  planners))
 
 
+def _at_least_one(text: str) -> int:
+    """An argparse type: a whole number of 1 or more."""
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
+def checked_files(paths: list[str], problems: int, planners: list[str]) -> list[Path]:
+    """The first ``problems`` scenario files of each path, every one loaded and every planner
+    label parsed here, so that a typo is one line before any callgrind run starts (each costs
+    10-30 s of start-up) rather than a failed run's stderr after it."""
+    from xfuzzy_rrt.bench.runner import scenario_files
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.planners.api import check_planner
+
+    for planner in planners:
+        check_planner(planner, "--planner")
+    files = [f for path in paths for f in scenario_files([Path(path)])[:problems]]
+    for f in files:
+        load_scenario(f)
+    return files
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("paths", nargs="+", help="scenario files or folders (a folder: its first "
                    "--problems files)")
     p.add_argument("--planner", action="append",
                    help="planner label (repeatable; default: fuzzy-rrt and rrt:tuned)")
-    p.add_argument("--problems", type=int, default=8, help="problems per folder (first N)")
-    p.add_argument("--seeds", type=int, default=3, help="seeds per problem")
-    p.add_argument("--max-iter", type=int, default=10_000)
+    p.add_argument("--problems", type=_at_least_one, default=8,
+                   help="problems per folder (first N)")
+    p.add_argument("--seeds", type=_at_least_one, default=3, help="seeds per problem")
+    p.add_argument("--max-iter", type=_at_least_one, default=10_000)
     p.add_argument("--child", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     planners = args.planner or ["fuzzy-rrt", "rrt:tuned"]
     if args.child:
         child(args.child, planners[0], [Path(f) for f in args.paths], args.seeds, args.max_iter)
         return 0
-    from xfuzzy_rrt.bench.runner import scenario_files
+    from xfuzzy_rrt.errors import InputError
 
-    files = [f for path in args.paths for f in scenario_files([Path(path)])[:args.problems]]
+    try:
+        files = checked_files(args.paths, args.problems, planners)
+    except InputError as err:
+        print(f"cold_misses: {err}", file=sys.stderr)
+        return 2
     rows = measure(files, planners, args.seeds, args.max_iter)
     print(f"{rows[0]['calls']} cold calls per planner; per call (simulated {LL[0] >> 20} MB "
           "last level, evicted before each call):")

@@ -15,9 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from conftest import load_script
-ROOT = Path(__file__).resolve().parents[1]
-DEMO = ROOT / "xfuzzy_rrt" / "data" / "scenarios" / "demo-gap.toml"
+from conftest import PROJECT, load_script
+
+DEMO = PROJECT / "xfuzzy_rrt" / "data" / "scenarios" / "demo-gap.toml"
 
 
 @pytest.fixture(scope="module")
@@ -40,6 +40,17 @@ def test_a_dump_becomes_per_call_counts_with_the_last_level_misses_summed(cold_m
     assert r["DLmr"] == 7.5 and r["DLmw"] == 2.5 and r["LL"] == 35
 
 
+def test_a_typo_in_a_planner_or_a_path_is_one_line_before_any_callgrind_run(cold_misses,
+                                                                           capsys, tmp_path):
+    assert cold_misses.main([str(DEMO), "--planner", "fuzy-rrt"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--planner" in err[0] and "fuzy-rrt" in err[0]
+    missing = tmp_path / "nowhere.toml"
+    assert cold_misses.main([str(missing)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nowhere.toml" in err[0]
+
+
 def test_a_dump_without_the_cache_simulation_is_refused(cold_misses):
     no_cache = "events: Ir\nsummary: 4000\n"
     with pytest.raises(SystemExit, match="ILmr"):
@@ -48,7 +59,7 @@ def test_a_dump_without_the_cache_simulation_is_refused(cold_misses):
 
 @pytest.mark.skipif(os.environ.get("XFUZZY_VALGRIND_TESTS") != "1",
                     reason="set XFUZZY_VALGRIND_TESTS=1 (the first run compiles under valgrind)")
-def test_cold_calls_are_counted_per_planner_and_repeat_exactly(cold_misses):
+def test_cold_calls_are_counted_per_planner_and_repeat_within_two_percent(cold_misses):
     if shutil.which("valgrind") is None:
         pytest.skip("valgrind is not installed")
     with tempfile.TemporaryDirectory() as tmp:

@@ -29,12 +29,25 @@ and a C compiler with ``valgrind/callgrind.h``. Run on problems nobody tuned on:
 
 To compare two versions of the code, run it from each checkout (``PYTHONPATH``) and compare
 the per-call counts: they are the same (within 0.1 %) on every run of the same code.
+
+``--by-function N`` says where the misses come from: the N compiled functions with the most
+misses per call, each planner. Callgrind sees numba's compiled code as anonymous memory, so
+the run also records every instruction's cost (``--dump-instr=yes``), keeps each loaded
+library's object code (numba drops it once loaded; the child keeps a reference) and maps
+addresses to functions with ``nm``'s symbol table of that object. A function's cost is its
+own (callees counted where they are, inlined code counted in its caller); what runs outside
+numba's code (Python, numpy, libc) is one row. Needs ``nm`` (binutils)::
+
+    python benchmarks/cold_misses.py /tmp/eval-dual3 --problems 4 --by-function 12
 """
 
 from __future__ import annotations
 
 import argparse
+import bisect
+import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -69,11 +82,25 @@ def build_helper(folder: Path) -> Path:
     return lib
 
 
-def child(helper: str, planner: str, files: list[Path], seeds: int, max_iter: int) -> None:
-    """Runs under callgrind: warm every call up uncounted, then count each call cold."""
+def child(helper: str, planner: str, files: list[Path], seeds: int, max_iter: int,
+          objects: Path | None = None) -> None:
+    """Runs under callgrind: warm every call up uncounted, then count each call cold. With
+    ``objects`` (a folder), also write there the object code of every compiled library the
+    package loaded and ``objects.json`` (:func:`keep_objects`)."""
     import ctypes
 
     import numpy as np
+
+    if objects is not None:
+        from numba.core.codegen import CPUCodeLibrary
+
+        loaded = CPUCodeLibrary._set_compiled_object
+
+        def keep(library, code):  # numba drops a cached library's object once it is loaded
+            library.kept_object_code = code
+            return loaded(library, code)
+
+        CPUCodeLibrary._set_compiled_object = keep
 
     from xfuzzy_rrt.geometry.scenario import load_scenario
     from xfuzzy_rrt.planners.api import load_shipped_default, plan_scenario, preloaded
@@ -95,24 +122,62 @@ def child(helper: str, planner: str, files: list[Path], seeds: int, max_iter: in
             plan_scenario(sc, planner, rulebook=given, seed=seed, max_iter=max_iter)
             lib.cg_toggle()
     lib.cg_dump()
+    if objects is not None:
+        keep_objects(objects)
+
+
+def keep_objects(folder: Path) -> None:
+    """Write each loaded overload of every ``xfuzzy_rrt`` dispatcher: its library's object
+    code (``<n>.o``) and, in ``objects.json``, the file, the overload's entry symbol and the
+    address it was loaded at (which places the object's symbols in memory)."""
+    from numba.core.registry import CPUDispatcher
+
+    folder.mkdir(parents=True, exist_ok=True)
+    rows, seen = [], set()
+    for name, module in sorted(sys.modules.items()):
+        if not name.startswith("xfuzzy_rrt"):
+            continue
+        for value in list(vars(module).values()):
+            if not isinstance(value, CPUDispatcher) or id(value) in seen:
+                continue
+            seen.add(id(value))
+            for cres in value.overloads.values():
+                code = getattr(cres.library, "kept_object_code", None)
+                if code is None:
+                    continue
+                path = folder / f"{len(rows)}.o"
+                path.write_bytes(code)
+                symbol = cres.fndesc.llvm_func_name
+                rows.append({"object": str(path), "symbol": symbol,
+                             "address": cres.library.get_pointer_to_function(symbol)})
+    (folder / "objects.json").write_text(json.dumps(rows))
 
 
 def count(helper: Path, planner: str, files: list[Path], seeds: int, max_iter: int,
-          work: Path) -> dict[str, float]:
-    """One planner's per-call event counts (a callgrind run of :func:`child`)."""
+          work: Path, top: int = 0) -> dict:
+    """One planner's per-call event counts (a callgrind run of :func:`child`); with ``top``,
+    also its ``top`` costliest compiled functions under ``"functions"`` (:func:`by_function`)."""
     tag = planner.replace(":", "_").replace("/", "_")
     out = work / f"{tag}.out"
+    objects = work / f"{tag}.objects"
     cmd = ["valgrind", "--tool=callgrind", "--instr-atstart=no", "--collect-atstart=no",
            "--cache-sim=yes", f"--LL={LL[0]},{LL[1]},{LL[2]}",
+           *(["--dump-instr=yes"] if top else []),
            f"--callgrind-out-file={out}.%p", sys.executable, __file__, "--child", str(helper),
            "--planner", planner, "--seeds", str(seeds), "--max-iter", str(max_iter),
-           *map(str, files)]
+           *(["--objects", str(objects)] if top else []), *map(str, files)]
     done = subprocess.run(cmd, capture_output=True, text=True)
     dumps = sorted(work.glob(f"{tag}.out.*.1"))
     if done.returncode != 0 or not dumps:
         tail = "\n".join(done.stderr.strip().splitlines()[-5:])
         raise SystemExit(f"cold_misses: the callgrind run of {planner} failed:\n{tail}")
-    return {"planner": planner, **per_call(dumps[-1].read_text(), len(files) * seeds)}
+    dump = dumps[-1].read_text()
+    calls = len(files) * seeds
+    row = {"planner": planner, **per_call(dump, calls)}
+    if top:
+        placed = json.loads((objects / "objects.json").read_text())
+        row["functions"] = by_function(dump, symbol_ranges(placed), calls)[:top]
+    return row
 
 
 def per_call(dump: str, calls: int) -> dict[str, float]:
@@ -130,19 +195,131 @@ def per_call(dump: str, calls: int) -> dict[str, float]:
             "LL": (values["ILmr"] + values["DLmr"] + values["DLmw"]) / calls}
 
 
+def instruction_costs(dump: str) -> tuple[list[str], dict[int, list[int]]]:
+    """The event names and each instruction address's *own* cost in a callgrind dump made
+    with ``--dump-instr=yes`` (``positions: instr line``). A cost line's positions are
+    absolute (``0x...``), relative (``+n``, ``-n``) or repeated (``*``); the line after a
+    ``calls=`` line is the callee's inclusive cost at the call site, which is skipped (the
+    callee's own lines count it)."""
+    lines = dump.splitlines()
+    events = next(line for line in lines if line.startswith("events:")).split()[1:]
+    positions = next((line.split()[1:] for line in lines if line.startswith("positions:")),
+                     ["line"])
+    if positions[0] != "instr":
+        raise SystemExit("cold_misses: the dump has no instruction addresses (--dump-instr=yes)")
+    width = len(positions)
+    last = [0] * width
+    costs: dict[int, list[int]] = {}
+    skip = False
+    for line in lines:
+        if line.startswith("calls="):
+            skip = True
+            continue
+        if not line or not (line[0] in "+-*" or line[0].isdigit()):
+            continue
+        fields = line.split()
+        for k in range(width):
+            tok = fields[k]
+            last[k] = (last[k] if tok == "*" else last[k] + int(tok) if tok[0] in "+-"
+                       else int(tok, 16) if tok.startswith("0x") else int(tok))
+        if skip:
+            skip = False
+            continue
+        values = [int(v) for v in fields[width:]]
+        row = costs.setdefault(last[0], [0] * len(events))
+        for k, v in enumerate(values):
+            row[k] += v
+    return events, costs
+
+
+def demangle(symbol: str) -> str:
+    """A numba symbol as ``module.function[tag]`` (``cpython.`` marks the wrapper Python
+    calls; ``[vN]`` tells specialisations of one function apart), else the symbol as it is.
+    Numba's Itanium-style names (``_ZN10xfuzzy_rrt8planners...B3v25...E...``) are too long
+    for ``c++filt`` to take every time, and only the qualified name and its tag matter here."""
+    start = symbol.find("_ZN")
+    if start < 0:
+        return symbol
+    i, parts = start + 3, []
+    while i < len(symbol) and symbol[i].isdigit():
+        j = i
+        while symbol[j].isdigit():
+            j += 1
+        n = int(symbol[i:j])
+        parts.append(symbol[j:j + n])
+        i = j + n
+    if not parts:
+        return symbol
+    tag = ""
+    m = re.match(r"B(\d+)", symbol[i:])
+    if m:
+        n = int(m.group(1))
+        tag = f"[{symbol[i + len(m.group(0)):i + len(m.group(0)) + n]}]"
+    return ".".join(parts).replace("_3clocals_3e", "<locals>") + tag
+
+
+def symbol_ranges(placed: list[dict]) -> list[tuple[int, int, str]]:
+    """``(start, end, name)`` in memory of every function of the objects :func:`keep_objects`
+    wrote, sorted: each object is placed by its entry symbol's loaded address minus that
+    symbol's offset in the object (numba loads an object's code as one block)."""
+    ranges = []
+    for row in placed:
+        listing = subprocess.run(["nm", "-S", row["object"]], capture_output=True,
+                                 text=True).stdout
+        symbols = []
+        for line in listing.splitlines():
+            fields = line.split()
+            if len(fields) == 4 and fields[2] in "TtWw":
+                symbols.append((int(fields[0], 16), int(fields[1], 16), fields[3]))
+        entry = [offset for offset, _, name in symbols if name == row["symbol"]]
+        if not entry:
+            continue
+        base = row["address"] - entry[0]
+        ranges += [(base + offset, base + offset + size, demangle(name))
+                   for offset, size, name in symbols if size > 0]
+    return sorted(ranges)
+
+
+#: The row that gathers what ran outside numba's compiled code.
+OUTSIDE = "(outside compiled code: Python, numpy, libc)"
+
+
+def by_function(dump: str, ranges: list[tuple[int, int, str]], calls: int) -> list[dict]:
+    """Per compiled function (by :func:`demangle`'d name; copies linked into several
+    libraries add up) its own ``Ir``, ``ILmr``, ``DLmr``, ``DLmw`` and ``LL`` per call, the
+    costliest (``LL``) first, with :data:`OUTSIDE` for addresses no range holds."""
+    events, costs = instruction_costs(dump)
+    starts = [r[0] for r in ranges]
+    totals: dict[str, list[int]] = {}
+    for address, values in costs.items():
+        k = bisect.bisect_right(starts, address) - 1
+        name = ranges[k][2] if k >= 0 and address < ranges[k][1] else OUTSIDE
+        row = totals.setdefault(name, [0] * len(events))
+        for j, v in enumerate(values):
+            row[j] += v
+    index = {e: k for k, e in enumerate(events)}
+    rows = []
+    for name, values in totals.items():
+        per = {e: values[index[e]] / calls for e in ("Ir", "ILmr", "DLmr", "DLmw")}
+        rows.append({"function": name, **per, "LL": per["ILmr"] + per["DLmr"] + per["DLmw"]})
+    return sorted(rows, key=lambda r: (-r["LL"], r["function"]))
+
+
 def measure(files: list[Path], planners: list[str], seeds: int = 3,
-            max_iter: int = 10_000) -> list[dict[str, float]]:
+            max_iter: int = 10_000, top: int = 0) -> list[dict]:
     """Per planner (in parallel, two at a time) the per-call counts over ``files`` x
     ``seeds`` cold calls: ``Ir``, ``ILmr``, ``DLmr``, ``DLmw`` (callgrind's names), ``LL``
-    (their sum of misses) and ``calls``."""
+    (their sum of misses) and ``calls``; with ``top``, ``functions`` too (:func:`count`)."""
     if shutil.which("valgrind") is None:
         raise SystemExit("cold_misses: valgrind is not installed")
+    if top and shutil.which("nm") is None:
+        raise SystemExit("cold_misses: --by-function needs nm (binutils)")
     with tempfile.TemporaryDirectory(prefix="cold-misses-") as tmp:
         work = Path(tmp)
         helper = build_helper(work)
         with ThreadPoolExecutor(max_workers=2) as pool:
-            return list(pool.map(lambda pl: count(helper, pl, files, seeds, max_iter, work),
-                                 planners))
+            return list(pool.map(
+                lambda pl: count(helper, pl, files, seeds, max_iter, work, top), planners))
 
 
 def _at_least_one(text: str) -> int:
@@ -179,11 +356,15 @@ def main(argv=None) -> int:
                    help="problems per folder (first N)")
     p.add_argument("--seeds", type=_at_least_one, default=3, help="seeds per problem")
     p.add_argument("--max-iter", type=_at_least_one, default=10_000)
+    p.add_argument("--by-function", type=_at_least_one, metavar="N",
+                   help="also print each planner's N compiled functions with the most misses")
     p.add_argument("--child", help=argparse.SUPPRESS)
+    p.add_argument("--objects", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     planners = args.planner or ["fuzzy-rrt", "rrt:tuned"]
     if args.child:
-        child(args.child, planners[0], [Path(f) for f in args.paths], args.seeds, args.max_iter)
+        child(args.child, planners[0], [Path(f) for f in args.paths], args.seeds, args.max_iter,
+              Path(args.objects) if args.objects else None)
         return 0
     from xfuzzy_rrt.errors import InputError
 
@@ -192,7 +373,7 @@ def main(argv=None) -> int:
     except InputError as err:
         print(f"cold_misses: {err}", file=sys.stderr)
         return 2
-    rows = measure(files, planners, args.seeds, args.max_iter)
+    rows = measure(files, planners, args.seeds, args.max_iter, args.by_function or 0)
     print(f"{rows[0]['calls']} cold calls per planner; per call (simulated {LL[0] >> 20} MB "
           "last level, evicted before each call):")
     print(f"{'planner':24s} {'Ir':>9s} {'ILmr':>7s} {'DLmr':>7s} {'DLmw':>7s} {'LL misses':>10s}"
@@ -200,6 +381,14 @@ def main(argv=None) -> int:
     for r in rows:
         print(f"{r['planner']:24s} {r['Ir']:9.0f} {r['ILmr']:7.0f} {r['DLmr']:7.0f}"
               f" {r['DLmw']:7.0f} {r['LL']:10.0f} {r['LL'] / rows[0]['LL']:8.3f}")
+    for r in rows:
+        if "functions" not in r:
+            continue
+        print(f"\n{r['planner']}: its {len(r['functions'])} costliest functions, per call")
+        print(f"{'Ir':>9s} {'ILmr':>7s} {'DLmr':>7s} {'DLmw':>7s} {'LL':>7s}  function")
+        for f in r["functions"]:
+            print(f"{f['Ir']:9.0f} {f['ILmr']:7.0f} {f['DLmr']:7.0f} {f['DLmw']:7.0f}"
+                  f" {f['LL']:7.0f}  {f['function']}")
     return 0
 
 

@@ -192,15 +192,19 @@ def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, sto
     cap = TA.nodes.shape[0]
     extensions = 0
 
-    add_node(TA, P.start, -1)
-    add_node(TB, P.goal, -1)
+    # the roots' indices (0) as add_node returns them, not as the constant: a constant makes
+    # node_clearance and the stop-record code under it a second compiled copy (for the literal
+    # 0) beside the one extend runs, ~130 more cold cache misses per call at 3+ joints
+    # (benchmarks/cold_misses.py --by-function, twenty-seventh session)
+    root_a = add_node(TA, P.start, -1)
+    root_b = add_node(TB, P.goal, -1)
     g = join_start_at_goal(P, TA)
     if g >= 0:  # the start is the goal: [start, goal], joined at the goal tree's root
         counts[0] = 0
         return True, 0, g, 0
     if has_obstacles:  # the roots' clearance, once; every other node keeps the one it was
-        TA.clear[0] = node_clearance(P, TA, 0)  # accepted with (extend)
-        TB.clear[0] = node_clearance(PR, TB, 0)
+        TA.clear[root_a] = node_clearance(P, TA, root_a)  # accepted with (extend)
+        TB.clear[root_b] = node_clearance(PR, TB, root_b)
     best = _joint_dist(P.start, P.goal)
     stagnation = 0.0
     g = START_TREE

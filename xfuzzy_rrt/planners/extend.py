@@ -186,7 +186,7 @@ def join_start_at_goal(P, T):
     for j in range(P.start.shape[0]):
         if P.start[j] != P.goal[j]:
             return -1
-    c = node_clearance(P, T, 0)
+    c = node_clearance(P, T, T.meta[0] - 1)  # the root (not the constant 0: connect.py)
     if not c > P.margin:
         return -1
     g = add_node(T, P.goal, 0)

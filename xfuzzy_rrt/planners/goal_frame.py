@@ -199,12 +199,12 @@ def _goal_frame_loop(P, T, seed, max_iter, knots, consts, min_step, stop, TR, st
     clear_top = knots[0, 2, 4]  # nothing to hit: clearance saturates at the top of its range
     has_obstacles = P.obstacles.shape[0] > 0 or P.arm_first.shape[0] > 2
 
-    add_node(T, P.start, -1)
+    root = add_node(T, P.start, -1)  # 0, not as a constant (connect.py: one compiled copy)
     g = join_start_at_goal(P, T)
     if g >= 0:
         return True, 0, g
     if has_obstacles:
-        T.clear[0] = node_clearance(P, T, 0)
+        T.clear[root] = node_clearance(P, T, root)
     current = 0
     best = _joint_dist(P.start, goal)
     stagnation = 0.0

@@ -143,8 +143,11 @@ def keep_objects(folder: Path) -> None:
             seen.add(id(value))
             for cres in value.overloads.values():
                 code = getattr(cres.library, "kept_object_code", None)
-                if code is None:
-                    continue
+                if code is None:  # compiled in this run, not loaded: numba keeps it itself
+                    try:
+                        code = cres.library._get_compiled_object()
+                    except RuntimeError:
+                        continue
                 path = folder / f"{len(rows)}.o"
                 path.write_bytes(code)
                 symbol = cres.fndesc.llvm_func_name
@@ -175,8 +178,11 @@ def count(helper: Path, planner: str, files: list[Path], seeds: int, max_iter: i
     calls = len(files) * seeds
     row = {"planner": planner, **per_call(dump, calls)}
     if top:
-        placed = json.loads((objects / "objects.json").read_text())
-        row["functions"] = by_function(dump, symbol_ranges(placed), calls)[:top]
+        ranges = symbol_ranges(json.loads((objects / "objects.json").read_text()))
+        if not ranges:
+            raise SystemExit(f"cold_misses: no compiled function of {planner} could be placed "
+                             "in memory (numba's object code was not kept)")
+        row["functions"] = by_function(dump, ranges, calls)[:top]
     return row
 
 

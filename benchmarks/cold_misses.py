@@ -19,9 +19,11 @@ is collected. The whole ``plan_scenario`` call is counted (set-up memo, kernel, 
 each planner's rulebooks or settings loaded once, as ``evaluate`` calls it. What it does not
 model: the TLB, the branch predictor and prefetching (sequential code misses cost less than
 scattered data ones). The code counted is what numba compiles for the CPU that valgrind
-presents (no AVX-512), not the host's: numba keys its cache on the CPU, so the first run on a
-machine compiles every kernel under valgrind (several minutes: over 5 in a CI run, which was
-stopped) and later runs take 10-30 s per planner, two planners at a time. Needs ``valgrind``
+presents (here ``haswell``, no AVX-512), not the host's. Numba keys its cache on the CPU, so
+each planner's kernels are first compiled natively for valgrind's CPU (:func:`valgrind_cpu`),
+and the callgrind run loads them: a machine's first run, or the first after an edit to the
+kernels, compiles at native speed (~8 min here; ~20 under valgrind), and later runs take
+10-30 s per planner, two planners at a time. Needs ``valgrind``
 and a C compiler with ``valgrind/callgrind.h``. Run on problems nobody tuned on::
 
     python benchmarks/cold_misses.py /tmp/eval-sample --problems 8 --seeds 3
@@ -102,16 +104,10 @@ def child(helper: str, planner: str, files: list[Path], seeds: int, max_iter: in
 
         CPUCodeLibrary._set_compiled_object = keep
 
-    from xfuzzy_rrt.geometry.scenario import load_scenario
-    from xfuzzy_rrt.planners.api import load_shipped_default, plan_scenario, preloaded
+    from xfuzzy_rrt.planners.api import plan_scenario
 
     lib = ctypes.CDLL(helper)
-    # as evaluate passes them: plain fuzzy-rrt's shipped default and every peer's settings
-    # loaded once (else each call resolves them again, which no timed call pays)
-    given = load_shipped_default() if planner == "fuzzy-rrt" else preloaded(planner, None)
-    scenarios = [load_scenario(f) for f in files]
-    for sc in scenarios:  # kernels loaded, set-ups remembered: not what a call costs
-        plan_scenario(sc, planner, rulebook=given, seed=0, max_iter=max_iter)
+    given, scenarios = warm_up(planner, files, max_iter)
     junk = np.zeros(EVICT_BYTES // 8)
     lib.cg_start()
     junk += 1.0
@@ -124,6 +120,45 @@ def child(helper: str, planner: str, files: list[Path], seeds: int, max_iter: in
     lib.cg_dump()
     if objects is not None:
         keep_objects(objects)
+
+
+def warm_up(planner: str, files: list[Path], max_iter: int):
+    """Load the planner's settings and the problems, and plan each problem once (kernels
+    loaded or compiled, set-ups remembered: not what a call costs); returns both."""
+    from xfuzzy_rrt.geometry.scenario import load_scenario
+    from xfuzzy_rrt.planners.api import load_shipped_default, plan_scenario, preloaded
+
+    # as evaluate passes them: plain fuzzy-rrt's shipped default and every peer's settings
+    # loaded once (else each call resolves them again, which no timed call pays)
+    given = load_shipped_default() if planner == "fuzzy-rrt" else preloaded(planner, None)
+    scenarios = [load_scenario(f) for f in files]
+    for sc in scenarios:
+        plan_scenario(sc, planner, rulebook=given, seed=0, max_iter=max_iter)
+    return given, scenarios
+
+
+#: Prints the CPU numba compiles for (its name, then its features as numba flattens them).
+CPU_PROBE = ("import llvmlite.binding as ll\n"
+             "from numba.core.codegen import get_host_cpu_features\n"
+             "print(ll.get_host_cpu_name())\nprint(get_host_cpu_features())")
+
+
+def valgrind_cpu() -> dict[str, str]:
+    """``NUMBA_CPU_NAME`` and ``NUMBA_CPU_FEATURES`` as numba sees the CPU under valgrind
+    (asked of a Python run under ``valgrind --tool=none``, ~10 s).
+
+    Why: numba keys its cache on the CPU, and valgrind presents another one than the host
+    (here ``haswell`` without AVX-512, on a Rocket Lake), so every kernel would compile under
+    valgrind, several times slower than natively (~20 min against ~8 here after an edit to the
+    kernels). With these two set, a native run compiles exactly the code valgrind's run will
+    load, under the same cache key."""
+    done = subprocess.run(["valgrind", "--tool=none", "-q", sys.executable, "-c", CPU_PROBE],
+                          capture_output=True, text=True)
+    lines = done.stdout.split()
+    if done.returncode != 0 or len(lines) != 2:
+        raise SystemExit("cold_misses: cannot ask valgrind which CPU it presents: "
+                         + (done.stderr.strip().splitlines() or ["no output"])[-1])
+    return {"NUMBA_CPU_NAME": lines[0], "NUMBA_CPU_FEATURES": lines[1]}
 
 
 def keep_objects(folder: Path) -> None:
@@ -157,9 +192,19 @@ def keep_objects(folder: Path) -> None:
 
 
 def count(helper: Path, planner: str, files: list[Path], seeds: int, max_iter: int,
-          work: Path, top: int = 0) -> dict:
+          work: Path, top: int = 0, cpu: dict[str, str] | None = None) -> dict:
     """One planner's per-call event counts (a callgrind run of :func:`child`); with ``top``,
-    also its ``top`` costliest compiled functions under ``"functions"`` (:func:`by_function`)."""
+    also its ``top`` costliest compiled functions under ``"functions"`` (:func:`by_function`).
+    With ``cpu`` (:func:`valgrind_cpu`), the kernels are first compiled natively for that CPU
+    (:func:`warm_up` in a process of its own), and the callgrind run loads them."""
+    env = {**os.environ, **(cpu or {})}
+    if cpu:
+        done = subprocess.run([sys.executable, __file__, "--precompile", "--planner", planner,
+                               "--max-iter", str(max_iter), *map(str, files)],
+                              capture_output=True, text=True, env=env)
+        if done.returncode != 0:
+            tail = "\n".join(done.stderr.strip().splitlines()[-5:])
+            raise SystemExit(f"cold_misses: compiling {planner} for valgrind's CPU failed:\n{tail}")
     tag = planner.replace(":", "_").replace("/", "_")
     out = work / f"{tag}.out"
     objects = work / f"{tag}.objects"
@@ -169,7 +214,7 @@ def count(helper: Path, planner: str, files: list[Path], seeds: int, max_iter: i
            f"--callgrind-out-file={out}.%p", sys.executable, __file__, "--child", str(helper),
            "--planner", planner, "--seeds", str(seeds), "--max-iter", str(max_iter),
            *(["--objects", str(objects)] if top else []), *map(str, files)]
-    done = subprocess.run(cmd, capture_output=True, text=True)
+    done = subprocess.run(cmd, capture_output=True, text=True, env=env)
     dumps = sorted(work.glob(f"{tag}.out.*.1"))
     if done.returncode != 0 or not dumps:
         tail = "\n".join(done.stderr.strip().splitlines()[-5:])
@@ -320,12 +365,13 @@ def measure(files: list[Path], planners: list[str], seeds: int = 3,
         raise SystemExit("cold_misses: valgrind is not installed")
     if top and shutil.which("nm") is None:
         raise SystemExit("cold_misses: --by-function needs nm (binutils)")
+    cpu = valgrind_cpu()
     with tempfile.TemporaryDirectory(prefix="cold-misses-") as tmp:
         work = Path(tmp)
         helper = build_helper(work)
         with ThreadPoolExecutor(max_workers=2) as pool:
             return list(pool.map(
-                lambda pl: count(helper, pl, files, seeds, max_iter, work, top), planners))
+                lambda pl: count(helper, pl, files, seeds, max_iter, work, top, cpu), planners))
 
 
 def _at_least_one(text: str) -> int:
@@ -366,8 +412,12 @@ def main(argv=None) -> int:
                    help="also print each planner's N compiled functions with the most misses")
     p.add_argument("--child", help=argparse.SUPPRESS)
     p.add_argument("--objects", help=argparse.SUPPRESS)
+    p.add_argument("--precompile", action="store_true", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     planners = args.planner or ["fuzzy-rrt", "rrt:tuned"]
+    if args.precompile:
+        warm_up(planners[0], [Path(f) for f in args.paths], args.max_iter)
+        return 0
     if args.child:
         child(args.child, planners[0], [Path(f) for f in args.paths], args.seeds, args.max_iter,
               Path(args.objects) if args.objects else None)

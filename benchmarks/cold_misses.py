@@ -22,8 +22,8 @@ scattered data ones). The code counted is what numba compiles for the CPU that v
 presents (here ``haswell``, no AVX-512), not the host's. Numba keys its cache on the CPU, so
 each planner's kernels are first compiled natively for valgrind's CPU (:func:`valgrind_cpu`),
 and the callgrind run loads them: a machine's first run, or the first after an edit to the
-kernels, compiles at native speed (~8 min here; ~20 under valgrind), and later runs take
-10-30 s per planner, two planners at a time. Needs ``valgrind``
+kernels, compiles at native speed (under valgrind, Fuzzy-RRT-Connect's kernels alone took 18
+min after an edit), and later runs take 10-30 s per planner, two planners at a time. Needs ``valgrind``
 and a C compiler with ``valgrind/callgrind.h``. Run on problems nobody tuned on::
 
     python benchmarks/cold_misses.py /tmp/eval-sample --problems 8 --seeds 3
@@ -149,8 +149,8 @@ def valgrind_cpu() -> dict[str, str]:
 
     Why: numba keys its cache on the CPU, and valgrind presents another one than the host
     (here ``haswell`` without AVX-512, on a Rocket Lake), so every kernel would compile under
-    valgrind, several times slower than natively (~20 min against ~8 here after an edit to the
-    kernels). With these two set, a native run compiles exactly the code valgrind's run will
+    valgrind, several times slower than natively (18 min for Fuzzy-RRT-Connect's kernels after
+    an edit). With these two set, a native run compiles exactly the code valgrind's run will
     load, under the same cache key."""
     done = subprocess.run(["valgrind", "--tool=none", "-q", sys.executable, "-c", CPU_PROBE],
                           capture_output=True, text=True)

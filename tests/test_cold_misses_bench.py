@@ -3,8 +3,9 @@ counts, and (with ``XFUZZY_VALGRIND_TESTS=1``) that it counts every planner's ca
 the same code gives the same counts. Its figures go in the measurement log, never asserted here.
 
 Why the second is opt-in: numba keys its cache on the CPU, and valgrind presents another one
-than the host (no AVX-512), so the first run on a machine compiles every kernel under valgrind,
-several minutes (over 5 in a CI run) that a clean checkout's CI would spend on one test."""
+than the host (no AVX-512), so the first run on a machine compiles every kernel it plans with a
+second time, for that CPU (natively since the twenty-seventh session; under valgrind before, over
+5 minutes in a CI run): minutes that a clean checkout's CI would spend on one test."""
 
 from __future__ import annotations
 

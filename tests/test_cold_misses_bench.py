@@ -110,7 +110,7 @@ def test_numba_symbols_read_as_module_function_and_specialisation(cold_misses):
 
 
 @pytest.mark.skipif(os.environ.get("XFUZZY_VALGRIND_TESTS") != "1",
-                    reason="set XFUZZY_VALGRIND_TESTS=1 (the first run compiles under valgrind)")
+                    reason="set XFUZZY_VALGRIND_TESTS=1 (a first run compiles every kernel again)")
 def test_cold_calls_are_counted_per_planner_and_repeat_within_two_percent(cold_misses):
     if shutil.which("valgrind") is None:
         pytest.skip("valgrind is not installed")
@@ -133,7 +133,7 @@ def test_cold_calls_are_counted_per_planner_and_repeat_within_two_percent(cold_m
 
 
 @pytest.mark.skipif(os.environ.get("XFUZZY_VALGRIND_TESTS") != "1",
-                    reason="set XFUZZY_VALGRIND_TESTS=1 (the first run compiles under valgrind)")
+                    reason="set XFUZZY_VALGRIND_TESTS=1 (a first run compiles every kernel again)")
 def test_every_miss_of_a_call_is_attributed_once_and_the_entry_is_named(cold_misses):
     if shutil.which("valgrind") is None or shutil.which("nm") is None:
         pytest.skip("valgrind or nm is not installed")

@@ -23,8 +23,8 @@ presents (here ``haswell``, no AVX-512), not the host's. Numba keys its cache on
 each planner's kernels are first compiled natively for valgrind's CPU (:func:`valgrind_cpu`),
 and the callgrind run loads them: a machine's first run, or the first after an edit to the
 kernels, compiles at native speed (under valgrind, Fuzzy-RRT-Connect's kernels alone took 18
-min after an edit), and later runs take 10-30 s per planner, two planners at a time. Needs ``valgrind``
-and a C compiler with ``valgrind/callgrind.h``. Run on problems nobody tuned on::
+min after an edit), and later runs take 10-30 s per planner, two planners at a time. Needs
+``valgrind`` and a C compiler with ``valgrind/callgrind.h``. Run on problems nobody tuned on::
 
     python benchmarks/cold_misses.py /tmp/eval-sample --problems 8 --seeds 3
     python benchmarks/cold_misses.py /tmp/eval-dual3 --planner fuzzy-rrt --planner rrt:tuned
@@ -203,8 +203,8 @@ def count(helper: Path, planner: str, files: list[Path], seeds: int, max_iter: i
                                "--max-iter", str(max_iter), *map(str, files)],
                               capture_output=True, text=True, env=env)
         if done.returncode != 0:
-            tail = "\n".join(done.stderr.strip().splitlines()[-5:])
-            raise SystemExit(f"cold_misses: compiling {planner} for valgrind's CPU failed:\n{tail}")
+            raise SystemExit(f"cold_misses: compiling {planner} for valgrind's CPU failed:\n"
+                             + _stderr_tail(done.stderr))
     tag = planner.replace(":", "_").replace("/", "_")
     out = work / f"{tag}.out"
     objects = work / f"{tag}.objects"
@@ -217,8 +217,8 @@ def count(helper: Path, planner: str, files: list[Path], seeds: int, max_iter: i
     done = subprocess.run(cmd, capture_output=True, text=True, env=env)
     dumps = sorted(work.glob(f"{tag}.out.*.1"))
     if done.returncode != 0 or not dumps:
-        tail = "\n".join(done.stderr.strip().splitlines()[-5:])
-        raise SystemExit(f"cold_misses: the callgrind run of {planner} failed:\n{tail}")
+        raise SystemExit(f"cold_misses: the callgrind run of {planner} failed:\n"
+                         + _stderr_tail(done.stderr))
     dump = dumps[-1].read_text()
     calls = len(files) * seeds
     row = {"planner": planner, **per_call(dump, calls)}
@@ -231,13 +231,24 @@ def count(helper: Path, planner: str, files: list[Path], seeds: int, max_iter: i
     return row
 
 
+def _header(lines: list[str], key: str, default: list[str] | None = None) -> list[str]:
+    """The fields after ``key:`` on a callgrind dump's header line of that name."""
+    found = next((line.split()[1:] for line in lines if line.startswith(key + ":")), default)
+    if found is None:
+        raise SystemExit(f"cold_misses: the dump has no {key}: line")
+    return found
+
+
+def _stderr_tail(text: str) -> str:
+    """The last five lines of a failed child's stderr, for the one error that reports it."""
+    return "\n".join(text.strip().splitlines()[-5:])
+
+
 def per_call(dump: str, calls: int) -> dict[str, float]:
     """The events of a callgrind dump (its ``events:`` and ``summary:`` lines) divided by the
     ``calls`` it collected, with ``LL`` the sum of the last-level misses."""
     lines = dump.splitlines()
-    names = next(line for line in lines if line.startswith("events:")).split()[1:]
-    values = dict(zip(names, map(int, next(line for line in lines
-                                           if line.startswith("summary:")).split()[1:])))
+    values = dict(zip(_header(lines, "events"), map(int, _header(lines, "summary"))))
     missing = [e for e in EVENTS if e not in values]
     if missing:
         raise SystemExit(f"cold_misses: the dump has no {', '.join(missing)} (cache simulation "
@@ -253,9 +264,8 @@ def instruction_costs(dump: str) -> tuple[list[str], dict[int, list[int]]]:
     ``calls=`` line is the callee's inclusive cost at the call site, which is skipped (the
     callee's own lines count it)."""
     lines = dump.splitlines()
-    events = next(line for line in lines if line.startswith("events:")).split()[1:]
-    positions = next((line.split()[1:] for line in lines if line.startswith("positions:")),
-                     ["line"])
+    events = _header(lines, "events")
+    positions = _header(lines, "positions", ["line"])
     if positions[0] != "instr":
         raise SystemExit("cold_misses: the dump has no instruction addresses (--dump-instr=yes)")
     width = len(positions)
@@ -294,9 +304,11 @@ def demangle(symbol: str) -> str:
     i, parts = start + 3, []
     while i < len(symbol) and symbol[i].isdigit():
         j = i
-        while symbol[j].isdigit():
+        while j < len(symbol) and symbol[j].isdigit():
             j += 1
         n = int(symbol[i:j])
+        if j == len(symbol) or j + n > len(symbol):  # cut short: keep the parts read
+            break
         parts.append(symbol[j:j + n])
         i = j + n
     if not parts:

@@ -107,6 +107,9 @@ def test_numba_symbols_read_as_module_function_and_specialisation(cold_misses):
     local = "_ZN5numba2np8arrayobj13_change_dtype12_3clocals_3e3impB4v124B4xxxxE"
     assert cold_misses.demangle(local) == "numba.np.arrayobj._change_dtype.<locals>.imp[v124]"
     assert cold_misses.demangle("memcpy") == "memcpy"
+    # a symbol cut short after a length prefix keeps the parts read (no IndexError)
+    assert cold_misses.demangle("_ZN10xfuzzy_rrt12") == "xfuzzy_rrt"
+    assert cold_misses.demangle("_ZN10xfuzzy_rrt8plan") == "xfuzzy_rrt"
 
 
 @pytest.mark.skipif(os.environ.get("XFUZZY_VALGRIND_TESTS") != "1",

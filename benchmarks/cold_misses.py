@@ -410,8 +410,16 @@ def checked_files(paths: list[str], problems: int, planners: list[str]) -> list[
     return files
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """An argument error is one line naming the option (exit 2), not argparse's usage block."""
+
+    def error(self, message):
+        print(f"cold_misses: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p = _OneLineParser(description=__doc__.split("\n")[0])
     p.add_argument("paths", nargs="+", help="scenario files or folders (a folder: its first "
                    "--problems files)")
     p.add_argument("--planner", action="append",

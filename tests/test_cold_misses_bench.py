@@ -46,6 +46,11 @@ def test_a_typo_in_a_planner_or_a_path_is_one_line_before_any_callgrind_run(cold
     assert cold_misses.main([str(DEMO), "--planner", "fuzy-rrt"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--planner" in err[0] and "fuzy-rrt" in err[0]
+    with pytest.raises(SystemExit) as stop:
+        cold_misses.main([str(DEMO), "--by-function", "0"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--by-function" in err[0] and "at least 1" in err[0]
     missing = tmp_path / "nowhere.toml"
     assert cold_misses.main([str(missing)]) == 2
     err = capsys.readouterr().err.strip().splitlines()

@@ -200,7 +200,8 @@ class Rulebook:
 
     @cached_property
     def compiled(self) -> tuple[np.ndarray, np.ndarray]:
-        """Read-only engine arrays, built once per rulebook (what the planners use).
+        """Read-only engine arrays, built once per rulebook (the planners pass writable copies of
+        them: :attr:`kernel_arrays`).
 
         A rulebook is immutable, so planning with the same object many times (the Python API,
         benchmarks) must not rebuild 3,750 (at 2 DOF) constants per call.
@@ -209,6 +210,22 @@ class Rulebook:
         knots.setflags(write=False)
         consts.setflags(write=False)
         return knots, consts
+
+    @cached_property
+    def kernel_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """:attr:`compiled`'s arrays as writable copies, made once: what the planners pass to
+        their compiled kernels, and nothing writes into them.
+
+        Why not the read-only ones: numba's dispatcher types a writable aligned array from a
+        small cache, but fingerprints a read-only one on every call (a string built and looked
+        up), code that a cold call fetches from memory (28 last-level misses of ~3,700 a cold
+        2-joint call, counted by ``benchmarks/cold_misses.py``); and a read-only array is
+        another numba type, so every kernel would be compiled a second time for it (the
+        problem's block and the stop flag stay writable for the same reason:
+        :mod:`xfuzzy_rrt.planners.problem_arena`).
+        """
+        knots, consts = self.compiled
+        return knots.copy(), consts.copy()
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray]:
         """Fresh C-contiguous ``(knots float64[n_out, 4, 5], consts float64[n_out, 625])`` for

@@ -456,7 +456,7 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
                                      max_time_s=max_time_s, min_step_deg=min_step_deg)
     rb = _resolve_rulebook(rulebook)
     check_connect_rulebook(rb, scenario)
-    knots, consts = rb.compiled
+    knots, consts = rb.kernel_arrays
     scale = length_scale(rb.semantics, scenario.dof)
     a = scenario_arrays(scenario)
     min_step = float(params["min_step_deg"])

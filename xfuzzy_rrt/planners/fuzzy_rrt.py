@@ -367,7 +367,7 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
                                      max_time_s=max_time_s, min_step_deg=min_step_deg)
     rb = _resolve_rulebook(rulebook)
     check_rulebook_fits(rb, scenario)
-    knots, consts = rb.compiled
+    knots, consts = rb.kernel_arrays
     mode = kernel_mode(rb)
     a = scenario_arrays(scenario)
     groups = fis_groups(rb, scenario)

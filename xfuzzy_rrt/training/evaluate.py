@@ -59,7 +59,7 @@ def run_population_measured(P, T, knots_b, consts_b, bounds_mode, seeds, max_ite
     n_seeds = seeds.shape[0]
     out = np.empty((n_ind, n_seeds, 3), dtype=np.int64)
     meta0 = T.meta.copy()
-    # With no trace (``None``) and the read-only rulebook arrays ``kernel_population`` passes,
+    # With no trace (``None``) and the writable rulebook arrays ``kernel_population`` passes,
     # the kernels below are the very specialisations an untraced plan compiles, so training
     # and planning share one compiled (cached) kernel each instead of compiling two (about
     # 100 s and 50 s each on a cold cache).
@@ -166,13 +166,12 @@ def iterations_for(problems: list[TrainingProblem], knots_b: np.ndarray, consts_
     return out
 
 
-def _read_only(a: np.ndarray) -> np.ndarray:
-    """A read-only view of *a* (the caller's array keeps its flags): numba types read-only
-    arrays apart, and a shipped rulebook's arrays are read-only, so a population passed this
+def _writable(a: np.ndarray) -> np.ndarray:
+    """*a*, or a writable copy of it when it is read-only: numba types read-only arrays
+    apart, and the planners pass writable rulebook arrays
+    (:attr:`~xfuzzy_rrt.fuzzy.rulebook.Rulebook.kernel_arrays`), so a population passed this
     way runs the planner's own compiled kernel rather than a second specialisation."""
-    view = a.view()
-    view.flags.writeable = False
-    return view
+    return a if a.flags.writeable else a.copy()
 
 
 def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, seeds,
@@ -181,7 +180,7 @@ def kernel_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, s
     the ``population`` of a semantics with no faster evaluation (goal-frame). With
     ``measure="work"``: int64[P, R, 2], iterations and work; ``"cost"``: int64[P, R, 3], also
     the path cost (:func:`run_population_measured`)."""
-    knots_b, consts_b = _read_only(knots_b), _read_only(consts_b)
+    knots_b, consts_b = _writable(knots_b), _writable(consts_b)
     if measure in ("work", "cost"):
         # a work counter of this call's own: Dask runs chunks in threads that share the
         # problem objects, and a shared counter would count the other thread's work too
@@ -240,7 +239,7 @@ def connect_population(pr: TrainingProblem, tree, knots_b, consts_b, mode: int, 
     # a work counter of this call's own (Dask threads share problem objects)
     bundle = pr.bundle._replace(work=np.zeros(1, dtype=np.int64))
     out = connect_population_measured(
-        bundle, ta, tb, _read_only(knots_b), _read_only(consts_b), seeds, int(max_iter),
+        bundle, ta, tb, _writable(knots_b), _writable(consts_b), seeds, int(max_iter),
         length_scale(GOAL_FRAME_ANY, pr.dof), MIN_STEP_DEG, np.zeros(1, dtype=np.int64),
         counts)
     return out if measure == "work" else out[:, :, 0].copy()

@@ -1,0 +1,68 @@
+"""The planners hand their compiled kernels writable copies of a rulebook's arrays, and training
+hands the same kernels the same types.
+
+Why it matters: numba's dispatcher fingerprints a read-only array on every call (code that a
+cold call fetches from memory), and types it apart from a writable one, so a read-only array
+anywhere on these paths compiles every kernel under it a second time."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numba.core import types
+
+from xfuzzy_rrt.geometry.scenario import load_scenario
+from xfuzzy_rrt.planners import connect, fuzzy_rrt
+from xfuzzy_rrt.planners.api import load_shipped_default, plan_scenario
+from xfuzzy_rrt.training.evaluate import TrainingProblem, iterations_for
+
+SCENARIO = Path(__file__).parent / "fixtures" / "scenarios" / "boxes-and-circle.toml"
+
+
+def _read_only_arrays(dispatcher) -> list:
+    """Every read-only array type in any signature *dispatcher* has compiled or loaded."""
+    return [(sig, a) for sig in dispatcher.signatures for a in sig
+            if isinstance(a, types.Array) and not a.mutable]
+
+
+def test_the_kernel_arrays_are_writable_copies_made_once_and_the_public_ones_stay_read_only():
+    rb = load_shipped_default().two_joint
+    knots, consts = rb.kernel_arrays
+    assert knots.flags.writeable and consts.flags.writeable
+    assert rb.kernel_arrays[0] is knots and rb.kernel_arrays[1] is consts
+    public = rb.compiled
+    assert not public[0].flags.writeable and not public[1].flags.writeable
+    assert not np.shares_memory(knots, public[0]) and not np.shares_memory(consts, public[1])
+    np.testing.assert_array_equal(knots, public[0])
+    np.testing.assert_array_equal(consts, public[1])
+
+
+@pytest.mark.parametrize("planner, entry", [("fuzzy-rrt", fuzzy_rrt.goal_frame_entry),
+                                            ("fuzzy-rrt-connect", connect.connect_entry)])
+@pytest.mark.parametrize("trace", [False, True])
+def test_a_plan_compiles_its_entry_for_writable_arrays_only(planner, entry, trace):
+    scenario = load_scenario(SCENARIO)
+    assert plan_scenario(scenario, planner, seed=0, trace=trace).success
+    assert entry.signatures, "the plan ran this entry"
+    assert _read_only_arrays(entry) == []
+
+
+def test_training_hands_the_kernels_writable_arrays_even_from_a_read_only_rulebook():
+    """The population entry is what Python calls (its signatures are recorded whether it was
+    compiled or loaded from the cache); it passes each individual's slice of these arrays to
+    the planner's kernel, so writable here means the kernel the planner compiled."""
+    from xfuzzy_rrt.training import evaluate
+
+    scenario = load_scenario(SCENARIO)
+    knots, consts = load_shipped_default().two_joint.compiled  # read-only, as a loaded rulebook's
+    out = iterations_for([TrainingProblem.from_scenario(scenario)], knots[None], consts[None],
+                         "goal-frame", np.arange(2, dtype=np.int64), 2000, measure="work")
+    assert out.shape == (1, 1, 2, 2) and (out[..., 0] > 0).all()
+    assert evaluate.run_population_measured.signatures, "training ran the population entry"
+    assert _read_only_arrays(evaluate.run_population_measured) == []
+    # and the same numbers as planning each seed
+    for r, seed in enumerate(range(2)):
+        plan = plan_scenario(scenario, "fuzzy-rrt", seed=seed, max_iter=2000)
+        assert (out[0, 0, r, 0], out[0, 0, r, 1]) == (plan.iterations, plan.work)

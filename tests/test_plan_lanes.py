@@ -186,6 +186,7 @@ def _same_but_the_budget(lane, general) -> None:
     _same(dataclasses.replace(lane, params={}), dataclasses.replace(general, params={}))
     extra = {k: v for k, v in general.params.items() if k not in ("max_time_s", "stopped_by")}
     assert lane.params == extra
+    assert list(lane.params) == list(extra)  # in the same order too (JSON, CSV columns)
     assert set(lane.__dict__) == set(general.__dict__)
     assert lane.min_clearance_m == general.min_clearance_m
     assert lane.penetration_m == general.penetration_m

@@ -516,7 +516,11 @@ def _lane(setup: _Setup, name: str, label: str):
     knots, consts, scale, min_step, max_iter = (setup.knots, setup.consts, setup.scale,
                                                 setup.min_step, setup.max_iter)
     trees_key = (setup.capacity, a.limits_deg, 2, a.stop_width)
-    recorded, margin = setup.recorded, float(setup.margin)
+    margin = float(setup.margin)
+    # the run's params with its three counts' keys already in place: a copy of a dict of every
+    # key takes them without growing (a dict of the five set-up keys grew on the sixth: ~30
+    # more cold misses a call, benchmarks/cold_misses.py); same keys, same order as _run's
+    slots = {**setup.recorded, "extensions": 0, "start_tree_nodes": 0, "goal_tree_nodes": 0}
     template = planner_template(name, label, PLANNER, rb)
     clock = time.perf_counter
 
@@ -530,7 +534,7 @@ def _lane(setup: _Setup, name: str, label: str):
         wall = clock() - t0
         if not same:
             raise RuntimeError("fuzzy-rrt-connect: the two trees' junction nodes differ")
-        params = dict(recorded)
+        params = dict(slots)
         params["extensions"] = extensions
         params["start_tree_nodes"] = na
         params["goal_tree_nodes"] = nb_

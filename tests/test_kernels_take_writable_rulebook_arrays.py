@@ -49,20 +49,27 @@ def test_a_plan_compiles_its_entry_for_writable_arrays_only(planner, entry, trac
     assert _read_only_arrays(entry) == []
 
 
-def test_training_hands_the_kernels_writable_arrays_even_from_a_read_only_rulebook():
+@pytest.mark.parametrize("semantics, planner, rulebook, population", [
+    ("goal-frame", "fuzzy-rrt", "two_joint", "run_population_measured"),
+    ("goal-frame-any", "fuzzy-rrt-connect", "any_arm", "connect_population_measured"),
+])
+def test_training_hands_the_kernels_writable_arrays_even_from_a_read_only_rulebook(
+        semantics, planner, rulebook, population):
     """The population entry is what Python calls (its signatures are recorded whether it was
     compiled or loaded from the cache); it passes each individual's slice of these arrays to
     the planner's kernel, so writable here means the kernel the planner compiled."""
     from xfuzzy_rrt.training import evaluate
 
     scenario = load_scenario(SCENARIO)
-    knots, consts = load_shipped_default().two_joint.compiled  # read-only, as a loaded rulebook's
+    rb = getattr(load_shipped_default(), rulebook)
+    knots, consts = rb.compiled  # read-only, as a loaded rulebook's
     out = iterations_for([TrainingProblem.from_scenario(scenario)], knots[None], consts[None],
-                         "goal-frame", np.arange(2, dtype=np.int64), 2000, measure="work")
+                         semantics, np.arange(2, dtype=np.int64), 2000, measure="work")
     assert out.shape == (1, 1, 2, 2) and (out[..., 0] > 0).all()
-    assert evaluate.run_population_measured.signatures, "training ran the population entry"
-    assert _read_only_arrays(evaluate.run_population_measured) == []
-    # and the same numbers as planning each seed
-    for r, seed in enumerate(range(2)):
-        plan = plan_scenario(scenario, "fuzzy-rrt", seed=seed, max_iter=2000)
-        assert (out[0, 0, r, 0], out[0, 0, r, 1]) == (plan.iterations, plan.work)
+    entry = getattr(evaluate, population)
+    assert entry.signatures, "training ran this population entry"
+    assert _read_only_arrays(entry) == []
+    # and the same numbers as planning each seed with that rulebook
+    for seed in range(2):
+        plan = plan_scenario(scenario, planner, rulebook=rb, seed=seed, max_iter=2000)
+        assert (out[0, 0, seed, 0], out[0, 0, seed, 1]) == (plan.iterations, plan.work)

@@ -151,7 +151,7 @@ def _warm_rrt_and_fuzzy_rrt() -> None:
     s = _warm_scenario()
     plan_scenario(s, planner="rrt", seed=0, max_iter=20)
     for name in ("goal-frame", "expert"):
-        for trace in (True, False):  # an untraced call is its entry's other specialisation
+        for trace in (True, False):  # an untraced call runs the entry's untraced twin
             plan_scenario(s, planner="fuzzy-rrt", rulebook=rulebooks_dir() / name, seed=0,
                           max_iter=20, trace=trace)
 

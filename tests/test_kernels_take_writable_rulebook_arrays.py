@@ -39,14 +39,21 @@ def test_the_kernel_arrays_are_writable_copies_made_once_and_the_public_ones_sta
     np.testing.assert_array_equal(consts, public[1])
 
 
-@pytest.mark.parametrize("planner, entry", [("fuzzy-rrt", fuzzy_rrt.goal_frame_entry),
-                                            ("fuzzy-rrt-connect", connect.connect_entry)])
+@pytest.mark.parametrize("planner, traced, untraced", [
+    ("fuzzy-rrt", fuzzy_rrt.goal_frame_entry, fuzzy_rrt.goal_frame_untraced),
+    ("fuzzy-rrt-connect", connect.connect_entry, connect.connect_untraced),
+])
 @pytest.mark.parametrize("trace", [False, True])
-def test_a_plan_compiles_its_entry_for_writable_arrays_only(planner, entry, trace):
+def test_a_plan_compiles_its_entry_for_writable_arrays_only(planner, traced, untraced, trace):
+    """(An untraced plan runs the entry's twin that takes no trace argument, since numba
+    fingerprints a ``None`` argument as it does a read-only array.)"""
+    entry = traced if trace else untraced
     scenario = load_scenario(SCENARIO)
     assert plan_scenario(scenario, planner, seed=0, trace=trace).success
     assert entry.signatures, "the plan ran this entry"
     assert _read_only_arrays(entry) == []
+    if not trace:
+        assert all(not isinstance(a, types.NoneType) for sig in entry.signatures for a in sig)
 
 
 @pytest.mark.parametrize("semantics, planner, rulebook, population", [

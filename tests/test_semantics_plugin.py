@@ -46,6 +46,7 @@ def twin():
     finally:
         sem.unregister("twin")
         fuzzy_rrt._ENTRIES.pop(TWIN_MODE, None)
+        fuzzy_rrt._UNTRACED.pop(TWIN_MODE, None)
     assert "twin" not in sem.SEMANTICS and "twin_dist_to_goal" not in sem.ALL_INPUT_RANGES
 
 
@@ -69,8 +70,22 @@ def test_the_planner_takes_kernel_and_fis_groups_from_the_semantics(twin):
     two_arms = SimpleNamespace(arms=[object(), object()])
     assert fuzzy_rrt.kernel_mode(rb) == TWIN_MODE
     assert fuzzy_rrt.entry_for(TWIN_MODE) is fuzzy_rrt.fuzzy_rrt_entry  # its declared kernel
+    assert fuzzy_rrt.untraced_for(TWIN_MODE) is fuzzy_rrt.fuzzy_rrt_untraced  # and its twin
     assert fuzzy_rrt.fis_groups(rb, two_arms) == 2  # one per arm, like the paper's
     assert sem.of_columns(["twin_angle_to_goal", "goal_bias"]) is twin
+
+
+def test_a_semantics_without_an_untraced_entry_gets_its_kernel_called_with_no_trace(twin):
+    calls = []
+
+    def kernel(*args):
+        calls.append(args)
+        return "finished"
+
+    sem.unregister("twin")
+    sem.register(replace(twin, kernel=kernel, untraced=None))
+    assert fuzzy_rrt.untraced_for(TWIN_MODE)(1, 2, 3) == "finished"
+    assert calls == [(1, 2, 3, None)]
 
 
 def test_the_builtin_semantics_declare_the_kernels_integers():
@@ -79,6 +94,8 @@ def test_the_builtin_semantics_declare_the_kernels_integers():
     assert dict(sem.GOAL_FRAME.modes) == {"goal-frame": fuzzy_rrt.GOAL_FRAME}
     assert sem.resolve(sem.PAPER.kernel) is fuzzy_rrt.fuzzy_rrt_entry
     assert sem.resolve(sem.GOAL_FRAME.kernel) is fuzzy_rrt.goal_frame_entry
+    assert sem.resolve(sem.PAPER.untraced) is fuzzy_rrt.fuzzy_rrt_untraced
+    assert sem.resolve(sem.GOAL_FRAME.untraced) is fuzzy_rrt.goal_frame_untraced
     assert genome.MODES == ("absolute", "relative", "goal-frame", "goal-frame-any")
     for s in (sem.PAPER, sem.GOAL_FRAME):
         for dof in range(sem.MIN_DOF, sem.MAX_DOF + 1):  # the plug-in survives for_dof

@@ -103,6 +103,12 @@ class Semantics:
     #: The Fuzzy-RRT kernel entry (the problem and the tree as arenas, the signature and the
     #: finished run it returns of ``planners/fuzzy_rrt.py:fuzzy_rrt_entry``), or ``None``.
     kernel: object = None
+    #: :attr:`kernel` for a run that records nothing, with the same arguments but the last
+    #: (``tr``), or ``None``: the planner then calls :attr:`kernel` with ``tr=None``. Why it
+    #: exists: numba's dispatcher types ``None`` by building and looking up a fingerprint on
+    #: every call, code that a cold call fetches from memory (~25 last-level misses a call,
+    #: ``benchmarks/cold_misses.py``); arrays and numbers take its fast path.
+    untraced: object = None
     #: The fitness evaluation of a population in training: ``fn(problem, tree, knots_b,
     #: consts_b, mode, seeds, max_iter) -> int64[P, R]`` iterations (``-1``: failed); one that
     #: also counts work (``"work"`` in :attr:`measures`) takes an eighth argument,
@@ -182,6 +188,7 @@ PAPER = Semantics(
     # the integers of planners/fuzzy_rrt.py's BOUNDS_ABSOLUTE and BOUNDS_RELATIVE
     modes=_ro({"absolute": 0, "relative": 1}),
     kernel="xfuzzy_rrt.planners.fuzzy_rrt:fuzzy_rrt_entry",
+    untraced="xfuzzy_rrt.planners.fuzzy_rrt:fuzzy_rrt_untraced",
     population="xfuzzy_rrt.training.evaluate:memo_population",
     per_arm=True,
 )
@@ -220,6 +227,7 @@ GOAL_FRAME = Semantics(
             "goal, step",
     modes=_ro({"goal-frame": 2}),  # planners/fuzzy_rrt.py's GOAL_FRAME
     kernel="xfuzzy_rrt.planners.fuzzy_rrt:goal_frame_entry",
+    untraced="xfuzzy_rrt.planners.fuzzy_rrt:goal_frame_untraced",
     population="xfuzzy_rrt.training.evaluate:kernel_population",
     measures=("iterations", "work", "cost"),
     earlier_output_ranges=_ro({"step_deg": ((0.0, 120.0),)}),

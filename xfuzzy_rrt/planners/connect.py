@@ -389,6 +389,27 @@ def finish_connect_run(nodes_a, parent_a, na, nodes_b, parent_b, nb_, last_a, la
     return nodes, parent, path, path_cost_compiled(path), vertices_within(path, limits), same
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def _connect_run(pblock, playout, block_a, layout_a, block_b, layout_b, seed, max_iter, knots,
+                 consts, scale, min_step, stop, TR, grown, connect_nodes):
+    """The body of :func:`connect_entry` and :func:`connect_untraced`: the problem and both
+    trees unpacked from their arenas (the trees emptied), the kernel run and the run finished."""
+    P = problem_in(pblock, playout)
+    TA = emptied_tree_in(block_a, layout_a)
+    TB = emptied_tree_in(block_b, layout_b)
+    counts = np.zeros(1, dtype=np.int64)
+    ok, it, last_a, last_b = connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale,
+                                            min_step, stop, TR, grown, connect_nodes, counts)
+    na = TA.meta[0]
+    nb_ = TB.meta[0]
+    nodes, parent, path, cost, within, same = finish_connect_run(
+        TA.nodes, TA.parent, na, TB.nodes, TB.parent, nb_, last_a if ok else -1, last_b,
+        P.limits)
+    work = P.work[0] + TA.meta[NN_VISITS] + TB.meta[NN_VISITS]
+    return (ok, it, last_a, last_b, counts[0], na, nb_, nodes, parent, path, cost, within, same,
+            work)
+
+
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def connect_entry(pblock, playout, block_a, layout_a, block_b, layout_b, seed, max_iter, knots,
                   consts, scale, min_step, stop, tr, grown, connect_nodes):
@@ -403,26 +424,24 @@ def connect_entry(pblock, playout, block_a, layout_a, block_b, layout_b, seed, m
     ``tr`` ``None`` (a run that records nothing; ``grown`` and ``connect_nodes`` are then
     ``None`` too): the kernel compiled without trace code runs, and no trace array is unboxed
     (an untraced call passed 16 idle arrays until the eleventh session, ~12 us of a 3-joint
-    call with cold caches; docs/peer-measurements.md)."""
-    P = problem_in(pblock, playout)
-    TA = emptied_tree_in(block_a, layout_a)
-    TB = emptied_tree_in(block_b, layout_b)
-    counts = np.zeros(1, dtype=np.int64)
+    call with cold caches; docs/peer-measurements.md). The planner itself runs such a run
+    through :func:`connect_untraced`, which takes none of the three."""
     if tr is None:  # decided when compiled: the branch not taken is not compiled at all
-        ok, it, last_a, last_b = connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale,
-                                                min_step, stop, None, None, None, counts)
-    else:
-        ok, it, last_a, last_b = connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale,
-                                                min_step, stop, TraceArrays(*tr), grown,
-                                                connect_nodes, counts)
-    na = TA.meta[0]
-    nb_ = TB.meta[0]
-    nodes, parent, path, cost, within, same = finish_connect_run(
-        TA.nodes, TA.parent, na, TB.nodes, TB.parent, nb_, last_a if ok else -1, last_b,
-        P.limits)
-    work = P.work[0] + TA.meta[NN_VISITS] + TB.meta[NN_VISITS]
-    return (ok, it, last_a, last_b, counts[0], na, nb_, nodes, parent, path, cost, within, same,
-            work)
+        return _connect_run(pblock, playout, block_a, layout_a, block_b, layout_b, seed,
+                            max_iter, knots, consts, scale, min_step, stop, None, None, None)
+    return _connect_run(pblock, playout, block_a, layout_a, block_b, layout_b, seed, max_iter,
+                        knots, consts, scale, min_step, stop, TraceArrays(*tr), grown,
+                        connect_nodes)
+
+
+@nb.njit(cache=True, nogil=True, _nrt=True)
+def connect_untraced(pblock, playout, block_a, layout_a, block_b, layout_b, seed, max_iter,
+                     knots, consts, scale, min_step, stop):
+    """:func:`connect_entry` with ``tr``, ``grown`` and ``connect_nodes`` ``None``, without
+    taking them: numba types a ``None`` argument by fingerprint on every call (~25 last-level
+    misses of a cold call; :attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.untraced`)."""
+    return _connect_run(pblock, playout, block_a, layout_a, block_b, layout_b, seed, max_iter,
+                        knots, consts, scale, min_step, stop, None, None, None)
 
 
 class _Setup(NamedTuple):
@@ -528,9 +547,9 @@ def _lane(setup: _Setup, name: str, label: str):
         arena_a, arena_b = pooled_trees(*trees_key)
         t0 = clock()
         (ok, iterations, last_a, last_b, extensions, na, nb_, nodes, parent, path, cost, within,
-         same, work) = connect_entry(pblock, playout, arena_a.block, arena_a.layout,
-                                     arena_b.block, arena_b.layout, seed, max_iter, knots,
-                                     consts, scale, min_step, NEVER_STOPPED, None, None, None)
+         same, work) = connect_untraced(pblock, playout, arena_a.block, arena_a.layout,
+                                        arena_b.block, arena_b.layout, seed, max_iter, knots,
+                                        consts, scale, min_step, NEVER_STOPPED)
         wall = clock() - t0
         if not same:
             raise RuntimeError("fuzzy-rrt-connect: the two trees' junction nodes differ")
@@ -559,27 +578,26 @@ def _run(setup: _Setup, name: str, label: str, seed, trace=False,
         buffers = make_trace(max_iter, a.dof, knots.shape[0], 1)
         grown = np.zeros(max_iter, dtype=np.int8)
         connect_nodes = np.zeros(max_iter, dtype=np.int64)
-        tr = tuple(buffers)
+        entry, tail = connect_entry, (tuple(buffers), grown, connect_nodes)
     else:  # no trace: the kernel compiled without trace code runs
-        tr = grown = connect_nodes = None
+        entry, tail = connect_untraced, ()
     args = (*setup.problem, arena_a.block, arena_a.layout, arena_b.block, arena_b.layout,
             int(seed))
     recorded = dict(setup.recorded)
     if max_time_s is None:  # the entry called here, not through a helper (one Python call less)
         t0 = time.perf_counter()
         (ok, iterations, last_a, last_b, extensions, na, nb_, nodes, parent, path, cost, within,
-         same, work) = connect_entry(*args, max_iter, knots, consts, scale, min_step,
-                                     NEVER_STOPPED, tr, grown, connect_nodes)
+         same, work) = entry(*args, max_iter, knots, consts, scale, min_step, NEVER_STOPPED,
+                             *tail)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
         # (the next run empties the trees again and counts its own work)
-        connect_entry(*args, 0, knots, consts, scale, min_step, np.zeros(1, dtype=np.int64), tr,
-                      grown, connect_nodes)
+        entry(*args, 0, knots, consts, scale, min_step, np.zeros(1, dtype=np.int64), *tail)
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
             (ok, iterations, last_a, last_b, extensions, na, nb_, nodes, parent, path, cost,
-             within, same, work) = connect_entry(*args, max_iter, knots, consts, scale, min_step,
-                                                 flag.array, tr, grown, connect_nodes)
+             within, same, work) = entry(*args, max_iter, knots, consts, scale, min_step,
+                                         flag.array, *tail)
             wall = time.perf_counter() - t0
     ok = bool(ok)
     na, nb_ = int(na), int(nb_)

@@ -274,6 +274,19 @@ def _fuzzy_rrt_loop(P, T, seed, max_iter, knots, consts, bounds_mode, min_step, 
     return False, max_iter, -1
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def _fuzzy_rrt_run(pblock, playout, block, layout, seed, max_iter, knots, consts, bounds_mode,
+                   min_step, stop, TR):
+    """:func:`fuzzy_rrt_kernel` on the problem and the tree unpacked from their arenas (the
+    tree emptied here), the run finished: the body of :func:`fuzzy_rrt_entry` and of
+    :func:`fuzzy_rrt_untraced`."""
+    P = problem_in(pblock, playout)
+    T = emptied_tree_in(block, layout)
+    ok, it, last = fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode, min_step,
+                                    stop, TR)
+    return finished_tree(P, T, ok, it, last)
+
+
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def fuzzy_rrt_entry(pblock, playout, block, layout, seed, max_iter, knots, consts, bounds_mode,
                     min_step, stop, tr):
@@ -281,15 +294,32 @@ def fuzzy_rrt_entry(pblock, playout, block, layout, seed, max_iter, knots, const
     here) and the trace bundle as a *plain* tuple; returns the run finished (see
     :func:`xfuzzy_rrt.planners.rrt.rrt_entry`: what a semantics' kernel entry takes and
     returns). ``tr`` ``None``: a run that records nothing, through the kernel compiled without
-    trace code."""
+    trace code (the planner itself calls :func:`fuzzy_rrt_untraced` for such a run)."""
+    if tr is None:  # decided when compiled: the branch not taken is not compiled at all
+        return _fuzzy_rrt_run(pblock, playout, block, layout, seed, max_iter, knots, consts,
+                              bounds_mode, min_step, stop, None)
+    return _fuzzy_rrt_run(pblock, playout, block, layout, seed, max_iter, knots, consts,
+                          bounds_mode, min_step, stop, TraceArrays(*tr))
+
+
+@nb.njit(cache=True, nogil=True, _nrt=True)
+def fuzzy_rrt_untraced(pblock, playout, block, layout, seed, max_iter, knots, consts,
+                       bounds_mode, min_step, stop):
+    """:func:`fuzzy_rrt_entry` with ``tr=None``, without taking it: numba types a ``None``
+    argument by fingerprint on every call (:attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.
+    untraced`), every other argument here through its fast path."""
+    return _fuzzy_rrt_run(pblock, playout, block, layout, seed, max_iter, knots, consts,
+                          bounds_mode, min_step, stop, None)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _goal_frame_run(pblock, playout, block, layout, seed, max_iter, knots, consts, mode,
+                    min_step, stop, TR):
+    """:func:`_fuzzy_rrt_run` for :func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`."""
     P = problem_in(pblock, playout)
     T = emptied_tree_in(block, layout)
-    if tr is None:  # decided when compiled: the branch not taken is not compiled at all
-        ok, it, last = fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode,
-                                        min_step, stop, None)
-    else:
-        ok, it, last = fuzzy_rrt_kernel(P, T, seed, max_iter, knots, consts, bounds_mode,
-                                        min_step, stop, TraceArrays(*tr))
+    ok, it, last = goal_frame_kernel(P, T, seed, max_iter, knots, consts, mode, min_step, stop,
+                                     TR)
     return finished_tree(P, T, ok, it, last)
 
 
@@ -297,15 +327,20 @@ def fuzzy_rrt_entry(pblock, playout, block, layout, seed, max_iter, knots, const
 def goal_frame_entry(pblock, playout, block, layout, seed, max_iter, knots, consts, mode,
                      min_step, stop, tr):
     """:func:`~xfuzzy_rrt.planners.goal_frame.goal_frame_kernel`, called as above."""
-    P = problem_in(pblock, playout)
-    T = emptied_tree_in(block, layout)
     if tr is None:  # decided when compiled, as above
-        ok, it, last = goal_frame_kernel(P, T, seed, max_iter, knots, consts, mode, min_step,
-                                         stop, None)
-    else:
-        ok, it, last = goal_frame_kernel(P, T, seed, max_iter, knots, consts, mode, min_step,
-                                         stop, TraceArrays(*tr))
-    return finished_tree(P, T, ok, it, last)
+        return _goal_frame_run(pblock, playout, block, layout, seed, max_iter, knots, consts,
+                               mode, min_step, stop, None)
+    return _goal_frame_run(pblock, playout, block, layout, seed, max_iter, knots, consts, mode,
+                           min_step, stop, TraceArrays(*tr))
+
+
+@nb.njit(cache=True, nogil=True, _nrt=True)
+def goal_frame_untraced(pblock, playout, block, layout, seed, max_iter, knots, consts, mode,
+                        min_step, stop):
+    """:func:`goal_frame_entry` with ``tr=None``, without taking it (as
+    :func:`fuzzy_rrt_untraced`)."""
+    return _goal_frame_run(pblock, playout, block, layout, seed, max_iter, knots, consts, mode,
+                           min_step, stop, None)
 
 
 def entry_for(mode: int):
@@ -328,6 +363,31 @@ def entry_for(mode: int):
 _ENTRIES: dict[int, object] = {}
 
 
+def untraced_for(mode: int):
+    """:func:`entry_for`'s entry for a run that records nothing, called without ``tr``: the
+    semantics' :attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.untraced` entry, or, for a
+    semantics with none, its entry with ``tr=None`` added."""
+    run = _UNTRACED.get(mode)
+    if run is None:
+        from xfuzzy_rrt.fuzzy.semantics import SEMANTICS, resolve
+
+        entry = entry_for(mode)
+        owner = next((s for s in SEMANTICS.values()
+                      if mode in s.modes.values() and s.kernel and resolve(s.kernel) is entry),
+                     None)
+        if owner is not None and owner.untraced:
+            run = resolve(owner.untraced)
+        else:
+            def run(*args, _entry=entry):
+                return _entry(*args, None)
+        _UNTRACED[mode] = run
+    return run
+
+
+#: mode -> untraced kernel entry (:func:`untraced_for`), filled on first use.
+_UNTRACED: dict[int, object] = {}
+
+
 def _resolve_rulebook(rulebook):
     """A loaded rulebook as given, else the (cached) directory or shipped default."""
     if rulebook is None:
@@ -348,6 +408,8 @@ class _Setup(NamedTuple):
     min_step: float
     params: dict
     kernel: Any
+    #: the kernel for a run that records nothing, taking no trace argument (:func:`untraced_for`)
+    untraced: Any
     mode: int
     knots: np.ndarray
     consts: np.ndarray
@@ -376,7 +438,7 @@ def _prepare(scenario: Scenario, rulebook, max_iter, min_step_deg, margin, clear
                 "bounds": rb.bounds_mode, "min_step_deg": float(min_step_deg),
                 "margin_m": float(margin)}
     return _Setup(rb, a, margin, int(max_iter), float(min_step_deg), params, entry_for(mode),
-                  mode, knots, consts, groups, problem, recorded, {})
+                  untraced_for(mode), mode, knots, consts, groups, problem, recorded, {})
 
 
 def _setup_for(scenario: Scenario, rulebook, max_iter, min_step_deg, margin,
@@ -428,8 +490,8 @@ def _lane(setup: _Setup, name: str, label: str):
     if run is not None:
         return run
     rb, a, max_iter = setup.rb, setup.arrays, setup.max_iter
-    knots, consts, mode, kernel, min_step = (setup.knots, setup.consts, setup.mode,
-                                             setup.kernel, setup.min_step)
+    knots, consts, mode, untraced, min_step = (setup.knots, setup.consts, setup.mode,
+                                               setup.untraced, setup.min_step)
     pblock, playout = setup.problem
     tree_key = (max_iter + 2, a.limits_deg, a.stop_width)
     recorded, margin = setup.recorded, float(setup.margin)
@@ -439,9 +501,9 @@ def _lane(setup: _Setup, name: str, label: str):
     def run(seed):
         arena = pooled_tree(*tree_key)
         t0 = clock()
-        ok, iterations, _, n, nodes, parents, path, cost, within, work = kernel(
+        ok, iterations, _, n, nodes, parents, path, cost, within, work = untraced(
             pblock, playout, arena.block, arena.layout, seed, max_iter, knots, consts, mode,
-            min_step, NEVER_STOPPED, None)
+            min_step, NEVER_STOPPED)
         wall = clock() - t0
         return bound_result(template, a, margin, ok, within, seed, iterations, n, cost, wall,
                             path, nodes, parents, work, dict(recorded))
@@ -458,27 +520,28 @@ def _run(setup: _Setup, name: str, label: str, seed, trace=False,
     if not trace and max_time_s is None:
         return _lane(setup, name, label)(int(seed))
     rb, a, margin, max_iter = setup.rb, setup.arrays, setup.margin, setup.max_iter
-    knots, consts, mode, kernel = setup.knots, setup.consts, setup.mode, setup.kernel
+    knots, consts, mode = setup.knots, setup.consts, setup.mode
     pblock, playout = setup.problem
     arena = pooled_tree(max_iter + 2, a.limits_deg, a.stop_width)
     block, layout = arena.block, arena.layout
-    # untraced: None, and the kernel compiled without trace code runs
     buffers = tuple(make_trace(max_iter, a.dof, knots.shape[0], setup.groups)) if trace else None
+    # untraced: the entry that takes no trace argument (untraced_for)
+    kernel, tail = (setup.kernel, (buffers,)) if trace else (setup.untraced, ())
     recorded = dict(setup.recorded)
     if max_time_s is None:
         t0 = time.perf_counter()
         ok, iterations, last, n, nodes, parents, path, cost, within, work = kernel(
             pblock, playout, block, layout, int(seed), max_iter, knots, consts, mode,
-            setup.min_step, NEVER_STOPPED, buffers)
+            setup.min_step, NEVER_STOPPED, *tail)
         wall = time.perf_counter() - t0
     else:  # the budget is for planning: compile (or load) the kernel first
         kernel(pblock, playout, block, layout, int(seed), 0, knots, consts, mode,
-               setup.min_step, np.zeros(1, dtype=np.int64), buffers)
+               setup.min_step, np.zeros(1, dtype=np.int64), *tail)
         with StopFlag(max_time_s) as flag:
             t0 = time.perf_counter()
             ok, iterations, last, n, nodes, parents, path, cost, within, work = kernel(
                 pblock, playout, block, layout, int(seed), max_iter, knots, consts, mode,
-                setup.min_step, flag.array, buffers)
+                setup.min_step, flag.array, *tail)
             wall = time.perf_counter() - t0
         recorded["max_time_s"] = float(setup.params["max_time_s"])
         recorded["stopped_by"] = stopped_by(bool(ok), int(iterations), max_iter, flag)

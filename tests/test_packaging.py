@@ -10,11 +10,11 @@ Compiling every kernel again in the fresh site-packages took 8 of the suite's mi
 busy cores and proves nothing about packaging (numba keys its cache on a hash of each source
 file's bytes, so the checkout's cache is valid for the byte-identical installed copy). So the
 installed copy starts from the checkout's numba cache, minus the entries of the goal-frame
-planner's entry (``goal_frame_entry``, which ``plan`` calls from Python; its kernel and every
-other callee load from the seeded cache, so only the entry itself compiles): the first
-``plan`` still compiles in the fresh site-packages, must say so on exactly one line and must
-leave that kernel cached there for the next command. Kernels the checkout has not compiled yet are simply compiled by the
-installed copy (slower, same checks).
+planner's untraced entry (``goal_frame_untraced``, which ``plan`` calls from Python; its
+kernel and every other callee load from the seeded cache, so only the entry itself compiles):
+the first ``plan`` still compiles in the fresh site-packages, must say so on exactly one line
+and must leave that kernel cached there for the next command. Kernels the checkout has not
+compiled yet are simply compiled by the installed copy (slower, same checks).
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ def installed(wheel, tmp_path_factory) -> Path:
 
 
 #: Cache entries left out of the seed, so that the installed copy's first ``plan`` compiles.
-UNSEEDED = "fuzzy_rrt.goal_frame_entry-"
+UNSEEDED = "fuzzy_rrt.goal_frame_untraced-"
 
 
 def _seed_numba_cache(package: Path) -> None:

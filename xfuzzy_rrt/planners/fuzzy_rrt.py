@@ -343,19 +343,25 @@ def goal_frame_untraced(pblock, playout, block, layout, seed, max_iter, knots, c
                            min_step, stop, None)
 
 
+def _kernel_owner(mode: int):
+    """The semantics whose Fuzzy-RRT kernel takes *mode* (a mode belongs to one semantics)."""
+    from xfuzzy_rrt.fuzzy.semantics import SEMANTICS
+
+    owner = next((s for s in SEMANTICS.values() if mode in s.modes.values() and s.kernel), None)
+    if owner is None:
+        raise ValueError(f"no semantics has a Fuzzy-RRT kernel for mode {mode!r}")
+    return owner
+
+
 def entry_for(mode: int):
     """The compiled loop of the semantics whose kernel takes *mode*, called with plain tuples
     (what :func:`plan_fuzzy_rrt` uses): :attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.kernel`,
-    looked up in one dict (a mode belongs to one semantics)."""
+    looked up in one dict."""
     entry = _ENTRIES.get(mode)
     if entry is None:
-        from xfuzzy_rrt.fuzzy.semantics import SEMANTICS, resolve
+        from xfuzzy_rrt.fuzzy.semantics import resolve
 
-        owner = next((s for s in SEMANTICS.values() if mode in s.modes.values() and s.kernel),
-                     None)
-        if owner is None:
-            raise ValueError(f"no semantics has a Fuzzy-RRT kernel for mode {mode!r}")
-        entry = _ENTRIES[mode] = resolve(owner.kernel)
+        entry = _ENTRIES[mode] = resolve(_kernel_owner(mode).kernel)
     return entry
 
 
@@ -365,21 +371,20 @@ _ENTRIES: dict[int, object] = {}
 
 def untraced_for(mode: int):
     """:func:`entry_for`'s entry for a run that records nothing, called without ``tr``: the
-    semantics' :attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.untraced` entry, or, for a
+    same semantics' :attr:`~xfuzzy_rrt.fuzzy.semantics.Semantics.untraced` entry, or, for a
     semantics with none, its entry with ``tr=None`` added."""
     run = _UNTRACED.get(mode)
     if run is None:
-        from xfuzzy_rrt.fuzzy.semantics import SEMANTICS, resolve
+        from xfuzzy_rrt.fuzzy.semantics import resolve
 
-        entry = entry_for(mode)
-        owner = next((s for s in SEMANTICS.values()
-                      if mode in s.modes.values() and s.kernel and resolve(s.kernel) is entry),
-                     None)
-        if owner is not None and owner.untraced:
+        owner = _kernel_owner(mode)
+        if owner.untraced:
             run = resolve(owner.untraced)
         else:
-            def run(*args, _entry=entry):
-                return _entry(*args, None)
+            entry = entry_for(mode)
+
+            def run(*args):
+                return entry(*args, None)
         _UNTRACED[mode] = run
     return run
 

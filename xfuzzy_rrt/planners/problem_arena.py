@@ -14,7 +14,8 @@ its one specialisation), with a fresh zeroed ``work`` counter made there.
 
 No kernel writes into a problem's arrays (only into its ``work`` counter, made per call), so
 the block is shared by every thread that plans the scenario with those settings: it belongs to
-a remembered set-up (:mod:`.setup_memo`). It is not flagged read-only, because numba types a
+a remembered set-up (:mod:`.setup_memo`), whose ``block`` the call passes and so holds for
+as long as the borrowed views live. It is not flagged read-only, because numba types a
 read-only array differently and every kernel would be compiled a second time for it.
 """
 
@@ -26,7 +27,7 @@ import numba as nb
 import numpy as np
 
 from xfuzzy_rrt.geometry.problem import Problem
-from xfuzzy_rrt.planners.tree_arena import field_bytes, packed
+from xfuzzy_rrt.planners.tree_arena import borrowed_1d, borrowed_2d, packed
 
 #: dtype and number of dimensions of each array field of :class:`Problem` before ``margin``,
 #: in order (links, arm_first, bases, radii, obstacles, limits, start, goal); row
@@ -59,17 +60,13 @@ def make_problem_arena(problem: Problem) -> ProblemArena:
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def problem_in(block, layout):
-    """The :class:`Problem` whose arrays are ``block``'s fields (views, no copy), with a fresh
-    zeroed ``work`` counter made here (each plan counts its own work)."""
-    f8, i8, L = np.float64, np.int64, layout
-    numbers = field_bytes(block, L, NUMBERS).view(f8)
+    """The :class:`Problem` whose arrays are ``block``'s fields, borrowed (no copy, no owner:
+    :mod:`.tree_arena`'s "Borrowed views"; for compiled callers, while they hold ``block``),
+    with a fresh zeroed ``work`` counter made here (each plan counts its own work)."""
+    f8, i8, L, b = np.float64, np.int64, layout, block
+    numbers = borrowed_1d(b, L, NUMBERS, f8)
     return Problem(
-        field_bytes(block, L, 0).view(f8),
-        field_bytes(block, L, 1).view(i8),
-        field_bytes(block, L, 2).view(f8).reshape((L[2, 2], L[2, 3])),
-        field_bytes(block, L, 3).view(f8),
-        field_bytes(block, L, 4).view(f8).reshape((L[4, 2], L[4, 3])),
-        field_bytes(block, L, 5).view(f8).reshape((L[5, 2], L[5, 3])),
-        field_bytes(block, L, 6).view(f8),
-        field_bytes(block, L, 7).view(f8),
+        borrowed_1d(b, L, 0, f8), borrowed_1d(b, L, 1, i8), borrowed_2d(b, L, 2, f8),
+        borrowed_1d(b, L, 3, f8), borrowed_2d(b, L, 4, f8), borrowed_2d(b, L, 5, f8),
+        borrowed_1d(b, L, 6, f8), borrowed_1d(b, L, 7, f8),
         numbers[0], numbers[1], np.zeros(1, dtype=np.int64))

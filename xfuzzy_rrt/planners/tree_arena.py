@@ -7,14 +7,28 @@ two trees of 17 arrays each, plus their reset in Python (two ``fill`` calls and 
 per tree); on a 3-joint problem that was ~5 us of a call whose whole planning often takes
 20-50 us. Here the tree's arrays are views into one ``uint8`` block (the *arena*), laid out by
 a small ``layout`` table; a compiled entry rebuilds the :class:`~xfuzzy_rrt.planners.tree.
-TreeArrays` record from the block with slices and ``view``/``reshape`` (no copy, no
-allocation) and empties the tree itself (:func:`emptied_tree_in`). The Python side keeps the
+TreeArrays` record from the block's address (borrowed views, below: no copy, no allocation)
+and empties the tree itself (:func:`emptied_tree_in`). The Python side keeps the
 same arrays as views, so reading ``tree.meta`` or ``tree.nodes`` after a run is unchanged.
 
 What goes in is exactly :func:`~xfuzzy_rrt.planners.tree.make_tree`'s tree (its shapes, dtypes
 and initial values: the fields are copied in), plus ``meta0``, the empty tree's ``meta``, as an
 18th field, so that emptying needs nothing from outside. Fields start at multiples of 64 bytes
 (aligned views: numba types them exactly as the separate arrays were typed).
+
+**Borrowed views.** A view made with ``block[o:o + n].view(...)`` holds a reference to the
+block: numba increments and decrements the block's reference count (an atomic operation) for
+each of the 17 views and again as they pass between functions, and calls its ``view`` and
+``reshape`` helpers for each. That was ~0.7 us of every call per tree, warm (a whole warm
+2-joint call of the tuned RRT takes 10-25 us). The compiled entries therefore rebuild the
+record from the block's address instead (:func:`borrowed_1d`, :func:`borrowed_2d`): arrays
+with no owner, which reference counting skips. This is sound because the views never outlive
+the call that was handed the block: the caller's ``block`` argument keeps it alive for the
+whole call, and what an entry returns is copied out of the tree
+(:func:`~xfuzzy_rrt.planners.result.finish_tree_run`;
+tests/test_results_outlive_the_pooled_trees.py checks that no result shares memory with a
+pooled tree and that the next plan leaves it as it was). Python code has the owning views in
+:attr:`TreeArena.tree`.
 """
 
 from __future__ import annotations
@@ -23,6 +37,8 @@ from typing import NamedTuple
 
 import numba as nb
 import numpy as np
+from numba.core import cgutils, types
+from numba.extending import intrinsic
 
 from xfuzzy_rrt.planners.tree import TreeArrays, make_tree, reset_tree
 
@@ -83,39 +99,45 @@ def packed(parts) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
     return block, layout, views
 
 
-@nb.njit(cache=True, nogil=True, inline="always")
-def field_bytes(b, L, k):
-    """Field ``k``'s bytes."""
-    return b[L[k, 0]:L[k, 0] + L[k, 1]]
+@intrinsic
+def _address(typingctx, where):
+    """The integer address ``where`` as a ``void *`` (what ``numba.carray`` takes)."""
+    if not isinstance(where, types.Integer):
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], cgutils.voidptr_t)
+
+    return types.voidptr(where), codegen
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _rows(L, k):
-    return (L[k, 2], L[k, 3])
+def borrowed_1d(b, L, k, dtype):
+    """Field ``k`` of block ``b`` as a 1-D ``dtype`` array of ``L[k, 2]`` items that borrows
+    the block (no owner: see the module docstring; valid only while the caller holds ``b``)."""
+    return nb.carray(_address(b.ctypes.data + L[k, 0]), L[k, 2], dtype)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def borrowed_2d(b, L, k, dtype):
+    """Field ``k`` of block ``b`` as a 2-D ``dtype`` array of ``L[k, 2]`` rows and ``L[k, 3]``
+    columns that borrows the block (see :func:`borrowed_1d`)."""
+    return nb.carray(_address(b.ctypes.data + L[k, 0]), (L[k, 2], L[k, 3]), dtype)
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def tree_in(block, layout):
-    """The :class:`TreeArrays` whose arrays are ``block``'s fields (views, no copy)."""
-    f8, i8, L = np.float64, np.int64, layout
+    """The :class:`TreeArrays` whose arrays are ``block``'s fields, borrowed (no copy, no
+    owner): for compiled callers, while they hold ``block`` (Python has
+    :attr:`TreeArena.tree`)."""
+    f8, i8, L, b = np.float64, np.int64, layout, block
     return TreeArrays(
-        field_bytes(block, L, 0).view(f8).reshape(_rows(L, 0)),
-        field_bytes(block, L, 1).view(i8),
-        field_bytes(block, L, 2).view(i8),
-        field_bytes(block, L, 3).view(i8),
-        field_bytes(block, L, 4).view(i8),
-        field_bytes(block, L, 5).view(f8),
-        field_bytes(block, L, 6).view(i8),
-        field_bytes(block, L, 7).view(i8),
-        field_bytes(block, L, 8).view(i8).reshape(_rows(L, 8)),
-        field_bytes(block, L, 9).view(f8),
-        field_bytes(block, L, 10).view(f8).reshape(_rows(L, 10)),
-        field_bytes(block, L, 11).view(f8),
-        field_bytes(block, L, 12).view(f8).reshape(_rows(L, 12)),
-        field_bytes(block, L, 13).view(np.uint64),
-        field_bytes(block, L, 14).view(f8).reshape(_rows(L, 14)),
-        field_bytes(block, L, 15).view(f8),
-        field_bytes(block, L, 16).view(f8).reshape(_rows(L, 16)))
+        borrowed_2d(b, L, 0, f8), borrowed_1d(b, L, 1, i8), borrowed_1d(b, L, 2, i8),
+        borrowed_1d(b, L, 3, i8), borrowed_1d(b, L, 4, i8), borrowed_1d(b, L, 5, f8),
+        borrowed_1d(b, L, 6, i8), borrowed_1d(b, L, 7, i8), borrowed_2d(b, L, 8, i8),
+        borrowed_1d(b, L, 9, f8), borrowed_2d(b, L, 10, f8), borrowed_1d(b, L, 11, f8),
+        borrowed_2d(b, L, 12, f8), borrowed_1d(b, L, 13, np.uint64), borrowed_2d(b, L, 14, f8),
+        borrowed_1d(b, L, 15, f8), borrowed_2d(b, L, 16, f8))
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)
@@ -123,5 +145,5 @@ def emptied_tree_in(block, layout):
     """:func:`tree_in`, emptied for a new run (:func:`~xfuzzy_rrt.planners.tree.reset_tree`
     with the block's own ``meta0``)."""
     T = tree_in(block, layout)
-    reset_tree(T, field_bytes(block, layout, META0).view(np.int64))
+    reset_tree(T, borrowed_1d(block, layout, META0, np.int64))
     return T

@@ -113,8 +113,7 @@ from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
-from numba import carray, types
-from numba.core.extending import intrinsic
+from numba import carray
 
 from xfuzzy_rrt.errors import InputError
 from xfuzzy_rrt.geometry import collision
@@ -125,6 +124,7 @@ from xfuzzy_rrt.geometry.problem import Problem
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter, check_positive
 from xfuzzy_rrt.planners.prepared import scenario_arrays
 from xfuzzy_rrt.planners.result import PlanResult, certified_result, path_cost_deg
+from xfuzzy_rrt.planners.tree_arena import pointer_at
 
 OMPL_PREFIX = "ompl:"
 MISSING_EXTRA = "ompl:* planners need the optional 'ompl' extra: pip install -e '.[ompl]'"
@@ -416,18 +416,6 @@ def _bundle_plain(ptr, counts, q):
 _bundle = _bundle_counting if COUNTS_WORK else _bundle_plain
 
 
-@intrinsic
-def _at(typingctx, address):
-    """The integer ``address`` (a buffer's ``ctypes.data``, held by Python) as a ``void*``."""
-    if not isinstance(address, types.Integer):
-        return None
-
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.voidptr))
-
-    return types.voidptr(address), codegen
-
-
 #: Explicit signatures: compiled (or loaded from the cache) at import, like a ``cfunc``, so the
 #: first plan of a process does not compile inside OMPL's timed ``solve`` (and hit its cap).
 _AT3 = nb.types.boolean(nb.types.intp, nb.types.intp, nb.types.intp)
@@ -451,10 +439,10 @@ def state_free_at(q_at, buffer_at, counts_at):
     once; calling a ``cfunc`` through ctypes cost more per call in our measurements, passing
     arrays more still). The caller keeps the buffers alive while the addresses are in use.
     """
-    ptr = _at(buffer_at)
+    ptr = pointer_at(buffer_at)
     head = carray(ptr, (_HEADER,), dtype=np.float64)
-    counts = carray(_at(counts_at), (N_COUNTS,), dtype=np.int64)
-    q = carray(_at(q_at), (int(head[0]),), dtype=np.float64)
+    counts = carray(pointer_at(counts_at), (N_COUNTS,), dtype=np.int64)
+    q = carray(pointer_at(q_at), (int(head[0]),), dtype=np.float64)
     P = _bundle(ptr, counts, q)
     counts[STATE_CHECKS] += 1
     return config_free(P, q, P.margin)
@@ -465,12 +453,12 @@ def motion_free_at(qa_at, qb_at, buffer_at, counts_at):
     """Compiled certified check of the straight motion from the configuration at ``qa_at`` to
     the one at ``qb_at``: :func:`~xfuzzy_rrt.geometry.collision.edge_free` on the whole
     segment, both ends within the joint limits (``edge_free`` assumes it)."""
-    ptr = _at(buffer_at)
+    ptr = pointer_at(buffer_at)
     head = carray(ptr, (_HEADER,), dtype=np.float64)
-    counts = carray(_at(counts_at), (N_COUNTS,), dtype=np.int64)
+    counts = carray(pointer_at(counts_at), (N_COUNTS,), dtype=np.int64)
     dof = int(head[0])
-    qa = carray(_at(qa_at), (dof,), dtype=np.float64)
-    qb = carray(_at(qb_at), (dof,), dtype=np.float64)
+    qa = carray(pointer_at(qa_at), (dof,), dtype=np.float64)
+    qb = carray(pointer_at(qb_at), (dof,), dtype=np.float64)
     P = _bundle(ptr, counts, qa)
     counts[MOTION_CHECKS] += 1
     ok = within_limits(P.limits, qa) and within_limits(P.limits, qb) and \
@@ -491,14 +479,14 @@ def motion_free_logged_at(qa_at, qb_at, buffer_at, counts_at, log_at, meta_at):
     edges twice either (fair comparisons; :func:`segments_logged`)."""
     ok = motion_free_at(qa_at, qb_at, buffer_at, counts_at)
     if ok:
-        meta = carray(_at(meta_at), (2,), dtype=np.int64)
+        meta = carray(pointer_at(meta_at), (2,), dtype=np.int64)
         n = meta[0]
         if n < meta[1]:
-            ptr = _at(buffer_at)
+            ptr = pointer_at(buffer_at)
             dof = int(carray(ptr, (_HEADER,), dtype=np.float64)[0])
-            log = carray(_at(log_at), (meta[1], 2, dof), dtype=np.float64)
-            qa = carray(_at(qa_at), (dof,), dtype=np.float64)
-            qb = carray(_at(qb_at), (dof,), dtype=np.float64)
+            log = carray(pointer_at(log_at), (meta[1], 2, dof), dtype=np.float64)
+            qa = carray(pointer_at(qa_at), (dof,), dtype=np.float64)
+            qb = carray(pointer_at(qb_at), (dof,), dtype=np.float64)
             for j in range(dof):
                 log[n, 0, j] = qa[j]
                 log[n, 1, j] = qb[j]

@@ -37,7 +37,7 @@ from typing import NamedTuple
 
 import numba as nb
 import numpy as np
-from numba.core import cgutils, types
+from numba.core import types
 from numba.extending import intrinsic
 
 from xfuzzy_rrt.planners.tree import TreeArrays, make_tree, reset_tree
@@ -100,29 +100,30 @@ def packed(parts) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
 
 
 @intrinsic
-def _address(typingctx, where):
-    """The integer address ``where`` as a ``void *`` (what ``numba.carray`` takes)."""
-    if not isinstance(where, types.Integer):
+def pointer_at(typingctx, address):
+    """The integer ``address`` (a buffer's ``ctypes.data``, the buffer held by the caller) as a
+    ``void*``, what ``numba.carray`` takes (also the OMPL bridge's callbacks' buffers)."""
+    if not isinstance(address, types.Integer):
         return None
 
     def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], cgutils.voidptr_t)
+        return builder.inttoptr(args[0], context.get_value_type(types.voidptr))
 
-    return types.voidptr(where), codegen
+    return types.voidptr(address), codegen
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def borrowed_1d(b, L, k, dtype):
     """Field ``k`` of block ``b`` as a 1-D ``dtype`` array of ``L[k, 2]`` items that borrows
     the block (no owner: see the module docstring; valid only while the caller holds ``b``)."""
-    return nb.carray(_address(b.ctypes.data + L[k, 0]), L[k, 2], dtype)
+    return nb.carray(pointer_at(b.ctypes.data + L[k, 0]), L[k, 2], dtype)
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def borrowed_2d(b, L, k, dtype):
     """Field ``k`` of block ``b`` as a 2-D ``dtype`` array of ``L[k, 2]`` rows and ``L[k, 3]``
     columns that borrows the block (see :func:`borrowed_1d`)."""
-    return nb.carray(_address(b.ctypes.data + L[k, 0]), (L[k, 2], L[k, 3]), dtype)
+    return nb.carray(pointer_at(b.ctypes.data + L[k, 0]), (L[k, 2], L[k, 3]), dtype)
 
 
 @nb.njit(cache=True, nogil=True, _nrt=True)

@@ -71,3 +71,22 @@ def test_an_arena_refuses_a_tree_whose_fields_changed_kind(monkeypatch):
     monkeypatch.setattr(tree_arena, "make_tree", changed)
     with pytest.raises(TypeError, match="tree field parent is int32"):
         make_tree_arena(100, _limits(3))
+
+
+@pytest.mark.parametrize("width", [8.0, 700.0])
+def test_a_grid_of_one_cell_or_without_occupancy_words_is_emptied_too(width):
+    """Joint limits narrower than a grid cell give a 2-joint grid of one cell, and limits wider
+    than 640 degrees a grid with no occupancy words: a reused tree must still come back empty
+    (a stale cell head made the next run's nearest-node search loop forever)."""
+    limits = np.array([[0.0, width]] * 2)
+    rng = np.random.default_rng(7)
+    arena = make_tree_arena(300, limits)
+    fresh = make_tree(300, limits)
+    for _ in range(2):
+        for i in range(int(rng.integers(150, 300))):
+            add_node(arena.tree, rng.uniform(0.0, width, 2), i - 1)
+        assert (arena.tree.cell_head >= 0).any()
+        emptied_tree_in(arena.block, arena.layout)
+        for name in ("meta", "cell_head", "occ"):
+            np.testing.assert_array_equal(getattr(arena.tree, name), getattr(fresh, name),
+                                          err_msg=name)

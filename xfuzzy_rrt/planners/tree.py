@@ -584,17 +584,17 @@ def reset_tree(T, meta0):
     cells and their occupancy words are cleared, not the whole grid: a 36 x 36 grid is 10 KB,
     a short 2-joint plan fills a few of its cells, and clearing all of it wrote 162 cache lines
     per call, each one a miss when the call starts cold. A tree with more joints has no grid
-    (its box stays empty)."""
+    (its box stays empty, so nothing is cleared), while a 2-joint grid of one cell (joint
+    limits narrower than a cell) is cleared like any other. The occupancy words exist only for
+    grids of at most 64 x 64 cells (the test is :func:`add_node`'s)."""
     ncx = T.meta[NCX]
     ncy = T.meta[NCY]
     x0 = T.meta[BX0]
     x1 = T.meta[BX1]
-    grid = T.cell_head.shape[0] > 1
     occ = T.occ.shape[0] > 1
     for y in range(T.meta[BY0], T.meta[BY1] + 1):
-        if grid:
-            for x in range(x0, x1 + 1):
-                T.cell_head[y * ncx + x] = -1
+        for x in range(x0, x1 + 1):
+            T.cell_head[y * ncx + x] = -1
         if occ:
             T.occ[y] = 0
     if occ:

@@ -1,6 +1,7 @@
 """The fair protocol names the state of the caches every timed call starts from
 (xfuzzy_rrt/bench/caches.py): ``cold`` evicts them before each timed call, ``warm`` runs a
-planner's seeds of a problem in a row after an untimed call, ``shuffled`` is the earlier order.
+planner's seeds of a problem in a row (in interleaved blocks, each after an untimed call),
+``shuffled`` is the earlier order.
 No neighbour decides it: in the shuffled order ``rrt:tuned`` started warm whenever ``rrt``,
 its own kernel, had run before it in the seed's round. Only the timings depend on the mode."""
 
@@ -64,6 +65,47 @@ def test_warm_caches_run_each_planners_seeds_in_a_row_after_one_untimed_call(mon
     assert timed == expected
     assert sorted(result.runs["seed"].unique()) == [5, 6, 7]
     assert len(result.runs) == 2 * 3 * 3  # the untimed calls are not recorded
+
+
+def test_warm_blocks_interleave_the_planners_so_no_disturbance_slows_one_planner_only(
+        monkeypatch):
+    # A disturbance of the machine lasts as long as a block of calls: with one block per
+    # planner it slowed every seed of one planner (trap-9800-024, twenty-ninth session).
+    monkeypatch.setattr(protocol, "WARM_BLOCK", 2)
+    events = _record(monkeypatch)
+    scenario = load_scenario(DEMO)
+    result = protocol.run_protocol([scenario], ENTRIES, runs=5, seed=5, max_iter=200,
+                                   caches="warm")
+    timed = [e for e in events if e[3] == 200]
+    names = ["rrt", "rrt:tuned", "fuzzy-rrt"]
+    expected = []
+    for b, seeds in enumerate([(5, 6), (7, 8), (9,)]):
+        for e in protocol.block_order(3, 0, b):
+            expected += [(scenario.name, names[e], seeds[0], 200)]  # untimed: the block's first
+            expected += [(scenario.name, names[e], s, 200) for s in seeds]
+    assert timed == expected
+    # each planner's first timed call comes before any planner's second block
+    firsts = [timed.index((scenario.name, n, 7, 200)) for n in names]
+    lasts = [len(timed) - 1 - timed[::-1].index((scenario.name, n, 6, 200)) for n in names]
+    assert max(lasts) < min(firsts)
+    runs = result.runs
+    assert len(runs) == 3 * 5
+    for name in names:  # every seed once per planner, in seed order, as before
+        assert runs.loc[runs["planner"] == name, "seed"].tolist() == [5, 6, 7, 8, 9]
+
+
+def test_the_warm_blocks_order_differs_between_blocks_of_one_problem():
+    orders = [protocol.block_order(4, 3, b) for b in range(12)]
+    assert all(sorted(o) == list(range(4)) for o in orders)
+    assert len({tuple(o) for o in orders}) > 3
+
+
+def test_the_evaluate_help_and_output_name_the_warm_block_size():
+    from xfuzzy_rrt.cli import evaluate
+
+    assert f"blocks of {protocol.WARM_BLOCK} seeds" in evaluate._CACHES["warm"]
+    proc = run_main("evaluate", "--help")
+    assert f"blocks of {protocol.WARM_BLOCK}" in " ".join(proc.stdout.split())
 
 
 def test_block_orders_are_fixed_shuffles_that_vary_between_problems():

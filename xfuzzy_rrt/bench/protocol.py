@@ -62,7 +62,8 @@ against the paper's RRT (10°, goal bias 0.05).
 
 **The caches a timed call starts from** (:mod:`xfuzzy_rrt.bench.caches`) are named, not left
 to the neighbours: ``cold`` (default: evicted before every timed call), ``warm`` (a planner's
-seeds in a row) or ``shuffled`` (the earlier order); the summary's ``caches`` column says which.
+seeds in a row, in interleaved blocks of :data:`WARM_BLOCK` seeds) or ``shuffled`` (the earlier
+order); the summary's ``caches`` column says which.
 """
 
 from __future__ import annotations
@@ -137,10 +138,23 @@ def call_order(n: int, k: int) -> list[int]:
     return [int(i) for i in np.random.default_rng([0x5EED, k]).permutation(n)]
 
 
-def block_order(n: int, i: int) -> list[int]:
-    """The order of the ``n`` planners' blocks of runs on the ``i``-th problem under the
-    ``warm`` cache mode: a shuffle fixed by ``i``."""
-    return [int(x) for x in np.random.default_rng([0x5EED, 0xB10C, i]).permutation(n)]
+#: Seeds per block of the ``warm`` cache mode: each planner's seeds of a problem run in blocks
+#: of this many, the planners' blocks interleaved (:func:`run_protocol`).
+#:
+#: Why not one block per planner: a disturbance of the machine (another process, a page-cache
+#: flush) lasts milliseconds, as long as a whole block of 2-joint calls, so with one block it
+#: slowed every seed of one planner on one problem and set that problem's ratio by itself. The
+#: twenty-ninth session saw it: ``trap-9800-024`` measured 0.46x, its default's 50 calls taking
+#: 11-327 us where every other sitting had 12-41 us, and the family's worst case was that one
+#: disturbed block. Interleaved, a disturbance touches one block of each planner it overlaps:
+#: at most a fifth of a planner's 50 seeds, which a median over the seeds absorbs.
+WARM_BLOCK = 10
+
+
+def block_order(n: int, i: int, b: int = 0) -> list[int]:
+    """The order of the ``n`` planners' ``b``-th blocks of runs on the ``i``-th problem under
+    the ``warm`` cache mode: a shuffle fixed by ``i`` and ``b``."""
+    return [int(x) for x in np.random.default_rng([0x5EED, 0xB10C, i, b]).permutation(n)]
 
 
 def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs: int = 50,
@@ -153,7 +167,8 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     ``clearance_m`` is the certified margin every planner must keep (``None``: each scenario's).
     ``caches``: the state each timed call starts from (:mod:`xfuzzy_rrt.bench.caches`):
     ``cold`` (evicted before every call), ``warm`` (each planner's seeds of a problem in a row,
-    after an untimed call) or ``shuffled`` (planners shuffled per seed, nothing evicted). Only
+    in blocks of :data:`WARM_BLOCK` seeds, each block after an untimed call of its first seed,
+    the planners' blocks interleaved) or ``shuffled`` (planners shuffled per seed, nothing evicted). Only
     the timings depend on it.
 
     ``peers``: the labels that count as tuned peers for the best-peer columns (default: every
@@ -196,14 +211,18 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
                                **_one(sc, planner, rb, seed + k, max_iter, clearance_m)})
 
         if caches == "warm":
-            # Each planner's seeds in a row after one untimed call of its first seed: the
-            # calls a user who plans in a loop makes. The blocks' order is shuffled per
-            # problem, so no planner always follows another.
-            for e in block_order(n, i):
-                label, planner, rb = entries[e]
-                _one(sc, planner, rb, seed, max_iter, clearance_m)
-                for k in range(runs):
-                    timed(e, k)
+            # Each planner's seeds in a row, each block after one untimed call of its first
+            # seed: the calls a user who plans in a loop makes. The blocks are interleaved
+            # (the first block of every planner, then the second...), so a disturbance of
+            # the machine slows a block of each planner it overlaps, never all of one
+            # planner's seeds (WARM_BLOCK); their order is shuffled per problem and block, so
+            # no planner always follows another.
+            for b, first in enumerate(range(0, runs, WARM_BLOCK)):
+                for e in block_order(n, i, b):
+                    label, planner, rb = entries[e]
+                    _one(sc, planner, rb, seed + first, max_iter, clearance_m)
+                    for k in range(first, min(first + WARM_BLOCK, runs)):
+                        timed(e, k)
         else:
             # Seeds outer, planners inner: every planner runs seed k under the same machine
             # conditions, so a burst of load blurs all planners alike, not one planner's

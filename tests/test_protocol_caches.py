@@ -1,6 +1,6 @@
 """The fair protocol names the state of the caches every timed call starts from
 (xfuzzy_rrt/bench/caches.py): ``cold`` evicts them before each timed call, ``warm`` runs a
-planner's seeds of a problem in a row (in interleaved blocks, each after an untimed call),
+planner's seeds of a problem in a row (in interleaved blocks, each after untimed calls),
 ``shuffled`` is the earlier order.
 No neighbour decides it: in the shuffled order ``rrt:tuned`` started warm whenever ``rrt``,
 its own kernel, had run before it in the seed's round. Only the timings depend on the mode."""
@@ -49,7 +49,7 @@ def test_cold_caches_are_evicted_before_every_timed_call_and_only_then(monkeypat
                                      for i in protocol.call_order(3, k)]
 
 
-def test_warm_caches_run_each_planners_seeds_in_a_row_after_one_untimed_call(monkeypatch):
+def test_warm_caches_run_each_planners_seeds_in_a_row_after_untimed_calls(monkeypatch):
     events = _record(monkeypatch)
     scenarios = [load_scenario(DEMO), load_scenario(DATA / "demo-tissue.toml")]
     result = protocol.run_protocol(scenarios, ENTRIES, runs=3, seed=5, max_iter=200,
@@ -60,7 +60,8 @@ def test_warm_caches_run_each_planners_seeds_in_a_row_after_one_untimed_call(mon
     expected = []
     for i, sc in enumerate(scenarios):
         for e in protocol.block_order(3, i):
-            expected += [(sc.name, names[e], 5, 200)] * 2  # untimed, then the first seed
+            # untimed, then the first seed
+            expected += [(sc.name, names[e], 5, 200)] * (protocol.WARM_UP_CALLS + 1)
             expected += [(sc.name, names[e], 5 + k, 200) for k in (1, 2)]
     assert timed == expected
     assert sorted(result.runs["seed"].unique()) == [5, 6, 7]
@@ -81,7 +82,8 @@ def test_warm_blocks_interleave_the_planners_so_no_disturbance_slows_one_planner
     expected = []
     for b, seeds in enumerate([(5, 6), (7, 8), (9,)]):
         for e in protocol.block_order(3, 0, b):
-            expected += [(scenario.name, names[e], seeds[0], 200)]  # untimed: the block's first
+            # untimed: the block's first seed
+            expected += [(scenario.name, names[e], seeds[0], 200)] * protocol.WARM_UP_CALLS
             expected += [(scenario.name, names[e], s, 200) for s in seeds]
     assert timed == expected
     # each planner's first timed call comes before any planner's second block
@@ -103,9 +105,12 @@ def test_the_warm_blocks_order_differs_between_blocks_of_one_problem():
 def test_the_evaluate_help_and_output_name_the_warm_block_size():
     from xfuzzy_rrt.cli import evaluate
 
-    assert f"blocks of {protocol.WARM_BLOCK} seeds" in evaluate._CACHES["warm"]
-    proc = run_main("evaluate", "--help")
-    assert f"blocks of {protocol.WARM_BLOCK}" in " ".join(proc.stdout.split())
+    said = evaluate._CACHES["warm"]
+    assert f"blocks of {protocol.WARM_BLOCK} seeds" in said
+    assert f"after {protocol.WARM_UP_CALLS} untimed calls" in said
+    helped = " ".join(run_main("evaluate", "--help").stdout.split())
+    assert f"blocks of {protocol.WARM_BLOCK} seeds, each after {protocol.WARM_UP_CALLS} untimed" \
+        in helped
 
 
 def test_block_orders_are_fixed_shuffles_that_vary_between_problems():

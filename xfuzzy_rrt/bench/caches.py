@@ -15,8 +15,7 @@ the state every timed call starts from (:data:`CACHE_MODES`), and no neighbour d
   other work);
 - ``warm``: each planner runs its seeds of a problem in a row, in blocks of ten (the planners'
   blocks interleaved, so a disturbance of the machine never slows all of one planner's seeds),
-  each block after one untimed call (a user
-  who plans in a loop);
+  each block after three untimed calls (a user who plans in a loop);
 - ``shuffled``: the order of the tenth and eleventh sessions (planners shuffled per seed, no
   eviction), kept to compare with the figures measured that way.
 """

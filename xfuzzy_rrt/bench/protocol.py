@@ -150,6 +150,14 @@ def call_order(n: int, k: int) -> list[int]:
 #: at most a fifth of a planner's 50 seeds, which a median over the seeds absorbs.
 WARM_BLOCK = 10
 
+#: Untimed calls (of the block's first seed) before each ``warm`` block. One was not enough once
+#: the blocks were interleaved: after another planner's block, the first two timed calls of the
+#: default's block were ~8 % slower than mid-block (its loop is larger than the tuned RRT's and
+#: takes more than one call to warm), so blocks of 10 after one untimed call gave the default a
+#: 1-2 % lower geomean ratio than one block of 50 (sample 1.08x against 1.10x, three runs each,
+#: thirtieth session); after three untimed calls, 1.09x and on ``mira`` 1.11x against 1.10x.
+WARM_UP_CALLS = 3
+
 
 def block_order(n: int, i: int, b: int = 0) -> list[int]:
     """The order of the ``n`` planners' ``b``-th blocks of runs on the ``i``-th problem under
@@ -167,8 +175,8 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     ``clearance_m`` is the certified margin every planner must keep (``None``: each scenario's).
     ``caches``: the state each timed call starts from (:mod:`xfuzzy_rrt.bench.caches`):
     ``cold`` (evicted before every call), ``warm`` (each planner's seeds of a problem in a row,
-    in blocks of :data:`WARM_BLOCK` seeds, each block after an untimed call of its first seed,
-    the planners' blocks interleaved) or ``shuffled`` (planners shuffled per seed, nothing evicted). Only
+    in blocks of :data:`WARM_BLOCK` seeds, each block after :data:`WARM_UP_CALLS` untimed calls
+    of its first seed, the planners' blocks interleaved) or ``shuffled`` (planners shuffled per seed, nothing evicted). Only
     the timings depend on it.
 
     ``peers``: the labels that count as tuned peers for the best-peer columns (default: every
@@ -211,8 +219,8 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
                                **_one(sc, planner, rb, seed + k, max_iter, clearance_m)})
 
         if caches == "warm":
-            # Each planner's seeds in a row, each block after one untimed call of its first
-            # seed: the calls a user who plans in a loop makes. The blocks are interleaved
+            # Each planner's seeds in a row, each block after untimed calls of its first seed
+            # (WARM_UP_CALLS): the calls a user who plans in a loop makes. The blocks are interleaved
             # (the first block of every planner, then the second...), so a disturbance of
             # the machine slows a block of each planner it overlaps, never all of one
             # planner's seeds (WARM_BLOCK); their order is shuffled per problem and block, so
@@ -220,7 +228,8 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
             for b, first in enumerate(range(0, runs, WARM_BLOCK)):
                 for e in block_order(n, i, b):
                     label, planner, rb = entries[e]
-                    _one(sc, planner, rb, seed + first, max_iter, clearance_m)
+                    for _ in range(WARM_UP_CALLS):
+                        _one(sc, planner, rb, seed + first, max_iter, clearance_m)
                     for k in range(first, min(first + WARM_BLOCK, runs)):
                         timed(e, k)
         else:

@@ -38,7 +38,7 @@ def evaluate(
     max_iter: int = typer.Option(10_000, "--max-iter", help="Iteration budget per run; a failure counts as this many iterations."),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for runs.csv, problems.csv and summary.csv."),
     clearance: Optional[float] = typer.Option(None, "--clearance", help="Certified clearance in metres every planner must keep (default: each scenario's [safety] clearance_m, else 0)."),
-    caches: str = typer.Option("cold", "--caches", help="The state every timed call starts from: cold (the caches evicted before each call: a plan made between other work), warm (each planner's seeds of a problem in a row, in blocks of 10 seeds, each after an untimed call, the planners' blocks interleaved: plans made in a loop) or shuffled (planners shuffled per seed, nothing evicted: the tenth and eleventh sessions' figures). Only timings depend on it; cold writes 1.5x the last-level cache before each call (~2 ms here), so a run of 2-joint problems takes ~5x as long, 3-7 joints 1.1-2x."),
+    caches: str = typer.Option("cold", "--caches", help="The state every timed call starts from: cold (the caches evicted before each call: a plan made between other work), warm (each planner's seeds of a problem in a row, in blocks of 10 seeds, each after 3 untimed calls, the planners' blocks interleaved: plans made in a loop) or shuffled (planners shuffled per seed, nothing evicted: the tenth and eleventh sessions' figures). Only timings depend on it; cold writes 1.5x the last-level cache before each call (~2 ms here), so a run of 2-joint problems takes ~5x as long, 3-7 joints 1.1-2x."),
 ) -> int:
     """Evaluate rulebooks against RRT on a folder of problems: planners ranked on end-to-end
     time to the first certified path and on work against the tuned RRT (rrt:tuned), and on
@@ -177,7 +177,7 @@ def _table(header: list[str], rows: list[list[str]]) -> None:
 
 _CACHES = {"cold": "evicted before every timed call",
            "warm": "each planner's seeds of a problem in a row, in interleaved blocks of 10 seeds, "
-                   "each block after an untimed call",
+                   "each block after 3 untimed calls",
            "shuffled": "planners shuffled per seed, nothing evicted"}
 
 

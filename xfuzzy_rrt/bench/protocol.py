@@ -176,8 +176,8 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
     ``caches``: the state each timed call starts from (:mod:`xfuzzy_rrt.bench.caches`):
     ``cold`` (evicted before every call), ``warm`` (each planner's seeds of a problem in a row,
     in blocks of :data:`WARM_BLOCK` seeds, each block after :data:`WARM_UP_CALLS` untimed calls
-    of its first seed, the planners' blocks interleaved) or ``shuffled`` (planners shuffled per seed, nothing evicted). Only
-    the timings depend on it.
+    of its first seed, the planners' blocks interleaved) or ``shuffled`` (planners shuffled per
+    seed, nothing evicted). Only the timings depend on it.
 
     ``peers``: the labels that count as tuned peers for the best-peer columns (default: every
     label of *planners* that is not a Fuzzy-RRT one, i.e. ``rrt:tuned`` and ``ompl:...``).
@@ -220,11 +220,11 @@ def run_protocol(scenarios: list, planners: list[tuple[str, str, object]], runs:
 
         if caches == "warm":
             # Each planner's seeds in a row, each block after untimed calls of its first seed
-            # (WARM_UP_CALLS): the calls a user who plans in a loop makes. The blocks are interleaved
-            # (the first block of every planner, then the second...), so a disturbance of
-            # the machine slows a block of each planner it overlaps, never all of one
-            # planner's seeds (WARM_BLOCK); their order is shuffled per problem and block, so
-            # no planner always follows another.
+            # (WARM_UP_CALLS): the calls a user who plans in a loop makes. The blocks are
+            # interleaved (the first block of every planner, then the second...), so a
+            # disturbance of the machine slows a block of each planner it overlaps, never all
+            # of one planner's seeds (WARM_BLOCK); their order is shuffled per problem and
+            # block, so no planner always follows another.
             for b, first in enumerate(range(0, runs, WARM_BLOCK)):
                 for e in block_order(n, i, b):
                     label, planner, rb = entries[e]

@@ -36,7 +36,8 @@ def _pool_blocks() -> list[np.ndarray]:
 
 
 @pytest.mark.parametrize("relative, planner", CASES)
-def test_a_result_shares_no_memory_with_the_pooled_trees_and_survives_the_next_plan(relative, planner):
+def test_a_result_shares_no_memory_with_the_pooled_trees_and_survives_the_next_plan(
+        relative, planner):
     scenario = load_scenario(FIXTURES / relative)
     first = plan_scenario(scenario, planner, seed=3)
     assert first.success

@@ -202,8 +202,16 @@ def test_tune_refuses_evaluation_seeds_and_bad_grids_with_one_line(run_cli, tmp_
     assert not out.exists()
 
 
-def test_shipped_tuned_file_agrees_with_a_rerun_of_its_command():
-    """The shipped ``rrt.toml`` against its own provenance command, on a reduced grid.
+def _shipped_rrt_shapes():
+    from xfuzzy_rrt.planners.tuned import tuned_shapes
+
+    return tuned_shapes("rrt") or ((1, 2),)
+
+
+@pytest.mark.parametrize("shape", _shipped_rrt_shapes(), ids=lambda s: f"{s[0]}x{s[1]}")
+def test_shipped_tuned_file_agrees_with_a_rerun_of_its_command(shape):
+    """Each shipped ``rrt*.toml`` (one per arm shape: planners/tuned.py) against its own
+    provenance command, on a reduced grid.
 
     The full grid (35 points x 48 problems x 20 runs) takes minutes, too long for a test, so
     this re-runs the recorded command's problems, seeds and budget on two grid points -- the
@@ -215,12 +223,14 @@ def test_shipped_tuned_file_agrees_with_a_rerun_of_its_command():
     from xfuzzy_rrt.bench.tuning import default_grid, grid_points, run_tuning
     from xfuzzy_rrt.planners.tuned import tuned_path, tuned_record
 
-    record = tuned_record("rrt")
-    assert record is not None, f"{tuned_path('rrt')} is missing"
+    record = tuned_record("rrt", shape, exact=True)
+    assert record is not None, f"{tuned_path('rrt', shape)} is missing"
     prov = record["provenance"]
     argv = shlex.split(prov["command"])
     assert argv[:3] == ["xfuzzy-rrt", "tune", "rrt"] and "--grid" not in argv
     opts = dict(zip(argv[3::2], argv[4::2]))
+    dof, arms = int(opts.get("--dof", 2)), int(opts.get("--arms", 1))
+    assert (arms, arms * dof) == shape
     table = record["table"]
     assert [{k: r[k] for k in ("step_deg", "goal_bias")} for r in table] == \
         grid_points(default_grid("rrt"))
@@ -234,7 +244,8 @@ def test_shipped_tuned_file_agrees_with_a_rerun_of_its_command():
             "goal_bias": tuple(sorted({params["goal_bias"], other["goal_bias"]}))}
     again = run_tuning("rrt", problems=int(opts["--problems"]), seed=int(opts["--seed"]),
                        runs=int(opts["--runs"]), families=tuple(prov["families"]),
-                       max_iter=int(prov["max_iter"]), grid=grid, workers=2)
+                       max_iter=int(prov["max_iter"]), grid=grid, workers=2, dof=dof,
+                       arms=arms)
     recorded = {(r["step_deg"], r["goal_bias"]): r for r in table}
     for row in again.table:
         want = recorded[(row["step_deg"], row["goal_bias"])]

@@ -43,7 +43,8 @@ def untuned(monkeypatch):
     """No tuned OMPL range (whatever the shipped files say): the 10-degree default applies."""
     import xfuzzy_rrt.planners.tuned as tuned
 
-    monkeypatch.setattr(tuned, "tuned_params", lambda label: None)
+    monkeypatch.setattr(tuned, "tuned_params", lambda label, shape=(1, 2): None)
+    monkeypatch.setattr(tuned, "tuned_by_shape", lambda label: {})
 
 
 @pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
@@ -229,11 +230,11 @@ def test_the_range_comes_from_the_label_else_the_tuned_file_else_ten_degrees(mon
 
     asked = []
 
-    def fake(label):
+    def fake(label):  # every shipped shape's tuned parameters (planners/tuned.py)
         asked.append(label)
-        return {"range_deg": 42.0} if label == "ompl:RRTConnect" else None
+        return {(1, 2): {"range_deg": 42.0}} if label == "ompl:RRTConnect" else {}
 
-    monkeypatch.setattr(tuned, "tuned_params", fake)
+    monkeypatch.setattr(tuned, "tuned_by_shape", fake)
     s = load_scenario(TWO_CIRCLES)
     cases = {"ompl:RRTConnect": (42.0, "tuned"), "ompl:RRTConnect:sampled": (42.0, "tuned"),
              "ompl:RRTConnect:range=60": (60.0, "label"),
@@ -437,7 +438,7 @@ def test_an_ompl_range_read_once_plans_exactly_as_the_label_alone_and_is_not_rea
     given = preloaded("ompl:RRTConnect", None)
     assert isinstance(given, TunedRange) and given.base == "ompl:RRTConnect"
     alone = [plan_scenario(s, "ompl:RRTConnect", seed=k, max_iter=2000) for k in range(3)]
-    monkeypatch.setattr(tuned, "tuned_params", lambda label: pytest.fail("tuned file read"))
+    monkeypatch.setattr(tuned, "tuned_by_shape", lambda label: pytest.fail("tuned file read"))
     for k, ref in enumerate(alone):
         r = plan_scenario(s, "ompl:RRTConnect", rulebook=given, seed=k, max_iter=2000)
         assert (r.params["range_deg"], r.params["range_source"]) == \
@@ -458,8 +459,8 @@ def test_the_protocol_reads_each_ompl_peers_tuned_range_once(monkeypatch):
     from xfuzzy_rrt.bench.protocol import run_protocol
 
     reads = []
-    real = tuned.tuned_params
-    monkeypatch.setattr(tuned, "tuned_params", lambda label: reads.append(label) or real(label))
+    real = tuned.tuned_by_shape
+    monkeypatch.setattr(tuned, "tuned_by_shape", lambda label: reads.append(label) or real(label))
     s = load_scenario(TWO_CIRCLES)
     result = run_protocol([s], [("ompl:RRTConnect", "ompl:RRTConnect", None)], runs=3,
                           max_iter=500)

@@ -107,7 +107,7 @@ def test_named_parameters_have_defaults_ranges_and_one_clear_error():
     assert resolve_params("rrt")["step_deg"] == 10.0
     with pytest.raises(InputError, match=r"^goal_bias: must lie in \[0, 1\], got 1.5$"):
         resolve_params("rrt", goal_bias=1.5)
-    with pytest.raises(InputError, match=r"^step_deg: must lie in \(0, 360\] deg, got 0$"):
+    with pytest.raises(InputError, match=r"^step_deg: must lie in \(0, 1440\] deg, got 0$"):
         resolve_params("rrt", step_deg=0)
     with pytest.raises(InputError, match="is not a parameter of fuzzy-rrt"):
         resolve_params("fuzzy-rrt", step_deg=3.0)

@@ -412,9 +412,12 @@ def run_benchmark(scenarios: list[Scenario], planners: list[str], runs: int = 50
                 "rulebooks": [{"planner": label, "name": rb.name, "dir": rulebook_dirs[label],
                                "sha256": rb.sha256} for label, rb in rulebooks.items()]}
     if "rrt:tuned" in planners:  # the settings the tuned label resolved to (the report names them)
-        from xfuzzy_rrt.planners.tuned import tuned_params
+        from xfuzzy_rrt.planners.tuned import shape_of, shape_text, tuned_for_shapes
 
-        settings["tuned"] = {"rrt:tuned": tuned_params("rrt")}
+        rows = tuned_for_shapes("rrt", {shape_of(sc) for sc in by_name.values()})
+        # one tuned shape: its two settings, as before; several: each shape's (tuned.py)
+        settings["tuned"] = {"rrt:tuned": rows[0][1] if len(rows) == 1 else
+                             {"by_shape": {shape_text(s): p for s, p in rows}} if rows else None}
     return BenchResult(runs=runs_df, summary=summary, examples=examples, scenarios=by_name,
                        settings=settings, rulebook=main_rb, ratios=ratio_table(summary),
                        rulebooks=dict(rulebooks), worst_examples=worst)

@@ -58,10 +58,13 @@ DEFAULT_FAMILIES = ("sample", "hard", "mira")
 DEFAULT_PROBLEMS = 16
 DEFAULT_RUNS = 10
 DEFAULT_MAX_ITER = 10_000
-#: Values searched: steps/ranges from half the paper's 10° to two thirds of a turn. (Up to
-#: 120° until blocked edges became cheap to reject, issue 24: RRT's best step then moved to
-#: 120°, the edge of that grid, so the grid grew past it.)
-STEPS_DEG = (5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0, 120.0, 180.0, 240.0)
+#: Values searched: steps/ranges from half the paper's 10° to twice a turn. (Up to 120° until
+#: blocked edges became cheap to reject, issue 24: RRT's best step then moved to 120°, the edge
+#: of that grid, so the grid grew past it; up to 240° until the thirty-first session, when 300°
+#: needed 16 % less work than the 180° chosen on one 2-joint arm, and 480° was best with two
+#: 3-joint arms: the joint-space diameter is 360° x sqrt(joints).)
+STEPS_DEG = (5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0, 120.0, 180.0, 240.0, 300.0, 360.0,
+             480.0, 720.0)
 GOAL_BIASES = (0.0, 0.05, 0.1, 0.2, 0.3)
 #: Planner code the tuning numbers depend on (hashed into the provenance).
 CODE_FILES = ("planners/rrt.py", "planners/extend.py", "planners/tree.py", "planners/rng.py",
@@ -144,10 +147,35 @@ def check_seed(seed: int) -> int:
     return seed
 
 
-def training_problems(seed: int, problems: int, families: tuple[str, ...]) -> list:
-    """``problems`` generated problems of each family from generator ``seed`` (2-DOF)."""
+#: The "family" of problems with another shape than one 2-joint arm: the N-DOF / multi-arm
+#: generator (:func:`xfuzzy_rrt.scenarios.generate.generate_nd`), which has no families.
+ND_FAMILY = "nd"
+
+
+def check_shape(dof: int, arms: int, families: tuple[str, ...] = ()) -> None:
+    """``--dof`` and ``--arms`` as the generator takes them; ``--family`` only for one 2-joint
+    arm (the other shapes have one generator)."""
+    from xfuzzy_rrt.scenarios.generate import MAX_ARMS, MAX_DOF, MIN_ARMS, MIN_DOF
+
+    if not MIN_DOF <= dof <= MAX_DOF:
+        raise InputError("--dof", f"must be {MIN_DOF} to {MAX_DOF} joints per arm, got {dof}")
+    if not MIN_ARMS <= arms <= MAX_ARMS:
+        raise InputError("--arms", f"must be {MIN_ARMS} to {MAX_ARMS}, got {arms}")
+    if (dof, arms) != (2, 1) and tuple(families) not in ((), DEFAULT_FAMILIES, (ND_FAMILY,)):
+        raise InputError("--family", "families exist for one 2-joint arm only; with --dof or "
+                         "--arms the problems come from the N-joint generator")
+
+
+def training_problems(seed: int, problems: int, families: tuple[str, ...], dof: int = 2,
+                      arms: int = 1) -> list:
+    """``problems`` generated problems of each family from generator ``seed`` (one 2-joint
+    arm), or ``problems`` problems of ``arms`` arms of ``dof`` joints each."""
     from xfuzzy_rrt.scenarios.generate import FAMILIES, generate_one
 
+    check_shape(dof, arms, families)
+    if (dof, arms) != (2, 1):
+        return [generate_one(seed, k, f"tune-{arms}x{dof}", dof=dof, arms=arms).scenario
+                for k in range(problems)]
     for f in families:
         if f not in FAMILIES:
             raise InputError("--family", f"must be one of {', '.join(FAMILIES)}, got {f!r}")
@@ -176,8 +204,9 @@ def _worker_init(warm) -> None:
 def run_tuning(label: str, problems: int = DEFAULT_PROBLEMS, seed: int = DEFAULT_SEED,
                runs: int = DEFAULT_RUNS, families: tuple[str, ...] = DEFAULT_FAMILIES,
                max_iter: int = DEFAULT_MAX_ITER, grid: dict | None = None, workers: int = 1,
-               progress: Progress | None = None) -> TuningResult:
-    """Search ``grid`` (default :func:`default_grid`) for planner ``label`` (module docstring).
+               progress: Progress | None = None, dof: int = 2, arms: int = 1) -> TuningResult:
+    """Search ``grid`` (default :func:`default_grid`) for planner ``label`` (module docstring)
+    on problems of ``arms`` arms of ``dof`` joints each (one 2-joint arm: ``families``).
 
     Every grid point runs on every problem with plan seeds ``0 .. runs - 1``; the result does
     not depend on ``workers``.
@@ -195,6 +224,9 @@ def run_tuning(label: str, problems: int = DEFAULT_PROBLEMS, seed: int = DEFAULT
 
     check_max_iter(max_iter)
     families = tuple(families)
+    check_shape(dof, arms, families)
+    if (dof, arms) != (2, 1):
+        families = (ND_FAMILY,)
     points = grid_points(grid)
     for p in points:  # every label and value is checked before any run
         planner, kwargs = planner_call(label, p)
@@ -203,7 +235,7 @@ def run_tuning(label: str, problems: int = DEFAULT_PROBLEMS, seed: int = DEFAULT
             from xfuzzy_rrt.planners.params import resolve_params
 
             resolve_params("rrt", **kwargs)
-    scenarios = training_problems(seed, problems, families)
+    scenarios = training_problems(seed, problems, families, dof, arms)
     jobs = [(sc, *planner_call(label, p), s, max_iter)
             for p in points for sc in scenarios for s in range(runs)]
     warm = [(scenarios[0], *planner_call(label, points[0]), 0, 5)]
@@ -246,7 +278,8 @@ def run_tuning(label: str, problems: int = DEFAULT_PROBLEMS, seed: int = DEFAULT
                                                      -table[k]["worst_success_rate"], k))
     best = {name: table[order[0]][name] for name in grid}
     settings = {"problems": problems, "seed": seed, "runs": runs, "families": list(families),
-                "max_iter": max_iter, "scenarios": [s.name for s in scenarios]}
+                "max_iter": max_iter, "scenarios": [s.name for s in scenarios], "dof": dof,
+                "arms": arms}
     return TuningResult(label=label, grid={k: tuple(v) for k, v in grid.items()}, table=table,
                         best=best, settings=settings)
 
@@ -257,7 +290,9 @@ def tune_command(result: TuningResult) -> str:
     s = result.settings
     parts = ["xfuzzy-rrt", "tune", result.label, "--problems", str(s["problems"]), "--seed",
              str(s["seed"]), "--runs", str(s["runs"])]
-    if tuple(s["families"]) != DEFAULT_FAMILIES:
+    if (s.get("dof", 2), s.get("arms", 1)) != (2, 1):
+        parts += ["--dof", str(s["dof"]), "--arms", str(s["arms"])]
+    elif tuple(s["families"]) != DEFAULT_FAMILIES:
         for f in s["families"]:
             parts += ["--family", f]
     if s["max_iter"] != DEFAULT_MAX_ITER:
@@ -289,6 +324,7 @@ def _num(x: float) -> str:
 def render_tuned_file(result: TuningResult) -> str:
     """The TOML text of the tuned file: deterministic (no dates, no times, no paths)."""
     from xfuzzy_rrt import __version__
+    from xfuzzy_rrt.planners.tuned import shape_text
 
     s = result.settings
     names = list(result.grid)
@@ -322,6 +358,9 @@ def render_tuned_file(result: TuningResult) -> str:
         f"generator_seed = {s['seed']}",
         f"families = [{families}]",
         f"problems_per_family = {s['problems']}",
+        f'shape = "{shape_text((s.get("arms", 1), s.get("arms", 1) * s.get("dof", 2)))}"',
+        f"joints_per_arm = {s.get('dof', 2)}",
+        f"arms = {s.get('arms', 1)}",
         f'plan_seeds = "0..{s["runs"] - 1}"',
         f"max_iter = {s['max_iter']}",
         f'grid = "{grid_text}"',

@@ -125,8 +125,8 @@ def evaluate(
                f"per problem, the baseline's median / the planner's (> 1: better). Ranked on "
                f"end-to-end time to the first certified path (the whole call) and on end-to-end "
                f"work (search + certification of the path), "
-               f"against {_describe(base)}; iterations (the paper's measure) against RRT "
-               f"(step 10 deg, goal bias 0.05). Times measured with {caches} caches "
+               f"against {_describe(base, scenarios)}; iterations (the paper's measure) against "
+               f"RRT (step 10 deg, goal bias 0.05). Times measured with {caches} caches "
                f"({_CACHES[caches]}). A failed run counts with the time, work and "
                f"iterations ({max_iter}) it spent; cost = median path cost / RRT's, "
                f"cost/{'peer' if base != 'rrt' else 'RRT'} = / {base}'s (< 1: shorter; medians "
@@ -181,14 +181,14 @@ _CACHES = {"cold": "evicted before every timed call",
            "shuffled": "planners shuffled per seed, nothing evicted"}
 
 
-def _describe(label: str) -> str:
-    """``rrt:tuned (step 60 deg, goal bias 0.1)``: a baseline with its settings."""
+def _describe(label: str, scenarios) -> str:
+    """``rrt:tuned (step 60 deg, goal bias 0.1)``: a baseline with its settings (per tuned
+    shape when the problems run with several shapes' settings:
+    :func:`~xfuzzy_rrt.planners.tuned.describe_tuned_rrt`)."""
     if label == "rrt:tuned":
-        from xfuzzy_rrt.planners.tuned import tuned_params
+        from xfuzzy_rrt.planners.tuned import describe_tuned_rrt, shape_of
 
-        p = tuned_params("rrt") or {}
-        return (f"rrt:tuned (step {p.get('step_deg', float('nan')):g} deg, goal bias "
-                f"{p.get('goal_bias', float('nan')):g})")
+        return f"rrt:tuned ({describe_tuned_rrt(shape_of(s) for s in scenarios)})"
     return "rrt (step 10 deg, goal bias 0.05)"
 
 

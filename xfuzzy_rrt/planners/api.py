@@ -137,13 +137,43 @@ class TunedRRT:
 
     step_deg: float
     goal_bias: float
+    #: ``((shape, step_deg, goal_bias), ...)``: every shipped shape's settings
+    #: (:mod:`xfuzzy_rrt.planners.tuned`, "Per arm shape"); a problem runs with those of its
+    #: nearest shape. Empty: ``step_deg``/``goal_bias`` for every problem (a caller's own).
+    by_shape: tuple = ()
+
+    def settings_for(self, shape) -> tuple[float, float, tuple | None]:
+        """``(step_deg, goal_bias, shape whose settings these are, or None)`` for a problem
+        of ``shape``."""
+        if not self.by_shape:
+            return self.step_deg, self.goal_bias, None
+        return _settings_for(self.by_shape, shape)
+
+
+@functools.lru_cache(maxsize=64)
+def _settings_for(by_shape: tuple, shape: tuple) -> tuple[float, float, tuple]:
+    """:meth:`TunedRRT.settings_for`, remembered: a timed call of the peer pays one dict
+    look-up, not a search over the shapes."""
+    from xfuzzy_rrt.planners.tuned import nearest_shape
+
+    near = nearest_shape(shape, [row[0] for row in by_shape])
+    row = next(r for r in by_shape if r[0] == near)
+    return row[1], row[2], near
 
 
 def load_tuned_rrt(where: str = "--planner") -> TunedRRT:
-    """``rrt:tuned``'s settings as the shipped tuned file gives them now (one InputError
-    naming ``where`` when the file is missing or broken)."""
+    """``rrt:tuned``'s settings as the shipped tuned files give them now, every shape's (one
+    InputError naming ``where`` when the 2-joint file is missing or a file is broken)."""
+    from xfuzzy_rrt.planners.tuned import TWO_JOINT, tuned_by_shape
+
     tuned = _tuned_rrt(where)
-    return TunedRRT(float(tuned["step_deg"]), float(tuned["goal_bias"]))
+    rows = []
+    for shape, params in tuned_by_shape("rrt").items():
+        _check_tuned_rrt(params, where, shape)
+        rows.append((shape, float(params["step_deg"]), float(params["goal_bias"])))
+    if not any(r[0] == TWO_JOINT for r in rows):
+        rows.append((TWO_JOINT, float(tuned["step_deg"]), float(tuned["goal_bias"])))
+    return TunedRRT(float(tuned["step_deg"]), float(tuned["goal_bias"]), tuple(sorted(rows)))
 
 
 def preloaded(planner: str, rulebook: Any) -> Any:
@@ -376,20 +406,39 @@ def plan_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max
                    goal_bias, trace, clearance_m, max_time_s) -> PlanResult:
     """``rrt`` with ``step_deg``/``goal_bias``; ``rrt:tuned`` with the tuned file's."""
     if spec.label == RRT_TUNED:  # the label fixes the settings: the tuned file's
+        from xfuzzy_rrt.planners.tuned import nearest_shape, shape_of, tuned_shapes
+
         if type(rulebook) is TunedRRT:  # read once by the caller (evaluate, bench)
-            return plan_rrt_as(RRT_TUNED, _TUNED_PARAMS, scenario, seed=seed,
+            step, bias, near = rulebook.settings_for(shape_of(scenario))
+            return plan_rrt_as(RRT_TUNED, _tuned_result_params(near), scenario, seed=seed,
                                max_iter=max_iter, clearance_m=clearance_m,
-                               max_time_s=max_time_s, step_deg=rulebook.step_deg,
-                               goal_bias=rulebook.goal_bias)
-        tuned = _tuned_rrt("--planner")
-        return plan_rrt_as(RRT_TUNED, _TUNED_PARAMS, scenario, seed=seed, max_iter=max_iter,
-                           clearance_m=clearance_m, max_time_s=max_time_s, **tuned)
+                               max_time_s=max_time_s, step_deg=step, goal_bias=bias)
+        shape = shape_of(scenario)
+        near = nearest_shape(shape, tuned_shapes("rrt")) if shape != (1, 2) else shape
+        tuned = _tuned_rrt("--planner", near or (1, 2))
+        return plan_rrt_as(RRT_TUNED, _tuned_result_params(near), scenario, seed=seed,
+                           max_iter=max_iter, clearance_m=clearance_m, max_time_s=max_time_s,
+                           **tuned)
     return plan_rrt(scenario, seed=seed, max_iter=max_iter, step_deg=step_deg,
                     goal_bias=goal_bias, clearance_m=clearance_m, max_time_s=max_time_s)
 
 
-#: What ``rrt:tuned`` adds to its result's ``params``.
-_TUNED_PARAMS = {"tuned": True}
+#: What ``rrt:tuned`` adds to its result's ``params``, per shape whose settings it ran with
+#: (``tuned_shape``: e.g. ``"2 arms, 6 joints"``; none for a caller's own settings). One dict
+#: per shape, made once: the result keeps it (read-only by convention, as before).
+_TUNED_PARAMS: dict = {}
+
+
+def _tuned_result_params(shape) -> dict:
+    params = _TUNED_PARAMS.get(shape)
+    if params is None:
+        from xfuzzy_rrt.planners.tuned import shape_text
+
+        params = {"tuned": True}
+        if shape is not None:
+            params["tuned_shape"] = shape_text(shape)
+        _TUNED_PARAMS[shape] = params
+    return params
 
 
 def bind_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, max_iter, step_deg,
@@ -403,9 +452,11 @@ def bind_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, max_iter,
     if spec.label == RRT_TUNED:
         if type(rulebook) is not TunedRRT:
             return None
-        return bind_rrt_as(RRT_TUNED, _TUNED_PARAMS, scenario, max_iter=max_iter,
-                           step_deg=rulebook.step_deg, goal_bias=rulebook.goal_bias,
-                           clearance_m=clearance_m)
+        from xfuzzy_rrt.planners.tuned import shape_of
+
+        step, bias, near = rulebook.settings_for(shape_of(scenario))
+        return bind_rrt_as(RRT_TUNED, _tuned_result_params(near), scenario, max_iter=max_iter,
+                           step_deg=step, goal_bias=bias, clearance_m=clearance_m)
     return bind_rrt_as("rrt", None, scenario, max_iter=max_iter, step_deg=step_deg,
                        goal_bias=goal_bias, clearance_m=clearance_m)
 
@@ -505,19 +556,24 @@ def _ompl_run(scenario_ref, label, max_iter, goal_bias, clearance_m, tuned, seed
                      clearance_m=clearance_m, time_limit_s=None, tuned=tuned)
 
 
-def _tuned_rrt(where: str) -> dict[str, float]:
-    """``step_deg`` and ``goal_bias`` of the shipped ``rrt.toml``, or one InputError.
+def _tuned_rrt(where: str, shape=(1, 2)) -> dict[str, float]:
+    """``step_deg`` and ``goal_bias`` of the shipped ``rrt.toml`` (or of ``shape``'s own file,
+    :mod:`~xfuzzy_rrt.planners.tuned`), or one InputError.
 
     The file is stat-ed on every call and parsed only when it changed
     (:func:`~xfuzzy_rrt.planners.tuned.tuned_record`); its parameters are returned as parsed,
     not copied (read-only: callers unpack them)."""
-    record = tuned_record("rrt")
+    record = tuned_record("rrt", shape, exact=True)
     tuned = None if record is None else record["params"]
-    if tuned is None or set(tuned) != {"step_deg", "goal_bias"}:
-        raise InputError(where, f"{RRT_TUNED} needs the tuned file {tuned_path('rrt')} with "
-                         "step_deg and goal_bias (make it with 'xfuzzy-rrt tune rrt --out "
-                         "FILE')")
+    _check_tuned_rrt(tuned, where, shape)
     return tuned
+
+
+def _check_tuned_rrt(tuned, where: str, shape) -> None:
+    if tuned is None or set(tuned) != {"step_deg", "goal_bias"}:
+        raise InputError(where, f"{RRT_TUNED} needs the tuned file {tuned_path('rrt', shape)} "
+                         "with step_deg and goal_bias (make it with 'xfuzzy-rrt tune rrt --out "
+                         "FILE')")
 
 
 #: The last ``(rulebook, folder)`` :func:`_same_rulebook` found read from that folder: a loop of

@@ -124,6 +124,7 @@ from xfuzzy_rrt.geometry.problem import Problem
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter, check_positive
 from xfuzzy_rrt.planners.prepared import scenario_arrays
 from xfuzzy_rrt.planners.result import PlanResult, certified_result, path_cost_deg
+from xfuzzy_rrt.planners.tuned import shape_of
 from xfuzzy_rrt.planners.tree_arena import pointer_at
 
 OMPL_PREFIX = "ompl:"
@@ -293,29 +294,58 @@ class TunedRange:
     base: str
     range_deg: float
     source: str
+    #: ``((shape, range_deg), ...)``: every shipped shape's tuned range
+    #: (:mod:`xfuzzy_rrt.planners.tuned`, "Per arm shape"); a problem runs at its nearest
+    #: shape's. Empty: ``range_deg`` for every problem.
+    by_shape: tuple = ()
+
+    def range_for(self, shape) -> tuple[float, str]:
+        """``(range_deg, source)`` for a problem of ``shape``: the nearest tuned shape's range
+        with source ``"tuned"`` (one 2-joint arm) or ``"tuned for 2 arms, 6 joints"``."""
+        if not self.by_shape:
+            return self.range_deg, self.source
+        return _range_for(self.by_shape, tuple(shape))
+
+
+@functools.lru_cache(maxsize=64)
+def _range_for(by_shape: tuple, shape: tuple) -> tuple[float, str]:
+    from xfuzzy_rrt.planners.tuned import TWO_JOINT, nearest_shape, shape_text
+
+    near = nearest_shape(shape, [row[0] for row in by_shape])
+    r = next(row[1] for row in by_shape if row[0] == near)
+    return r, "tuned" if near == TWO_JOINT else f"tuned for {shape_text(near)}"
+
+
+def _checked_range(base: str, tuned: dict) -> float:
+    r = float(tuned["range_deg"])
+    if not (math.isfinite(r) and r > 0.0):
+        raise InputError(base, f"tuned range must be a positive number of degrees, "
+                         f"got {tuned['range_deg']!r}")
+    return r
 
 
 def load_tuned_range(base: str) -> TunedRange:
-    """:class:`TunedRange` of ``ompl:NAME`` (``base``) as the tuned file gives it now; a broken
-    file is one InputError naming it."""
-    from xfuzzy_rrt.planners.tuned import tuned_params
+    """:class:`TunedRange` of ``ompl:NAME`` (``base``) as the tuned files give it now, every
+    shape's; a broken file is one InputError naming it."""
+    from xfuzzy_rrt.planners.tuned import tuned_by_shape
 
-    tuned = tuned_params(base) or {}
-    if tuned.get("range_deg") is not None:
-        r = float(tuned["range_deg"])
-        if not (math.isfinite(r) and r > 0.0):
-            raise InputError(base, f"tuned range must be a positive number of degrees, "
-                             f"got {tuned['range_deg']!r}")
-        return TunedRange(base, r, "tuned")
+    rows = tuple(sorted((shape, _checked_range(base, params))
+                        for shape, params in tuned_by_shape(base).items()
+                        if params.get("range_deg") is not None))
+    two = [r for shape, r in rows if shape == (1, 2)]
+    if rows:
+        return TunedRange(base, two[0] if two else rows[0][1], "tuned", rows)
     return TunedRange(base, DEFAULT_RANGE_DEG, "default")
 
 
 def resolve_range(spec: OmplLabel, step_deg: float | None = None,
-                  tuned: TunedRange | None = None) -> tuple[float, str]:
+                  tuned: TunedRange | None = None, shape=(1, 2)) -> tuple[float, str]:
     """``(range_deg, source)`` for a planner that has a range: the label's, else ``step_deg``
-    (an explicit argument), else the tuned range of ``ompl:NAME``, else ``DEFAULT_RANGE_DEG``.
-    ``source`` is ``"label"``, ``"argument"``, ``"tuned"`` or ``"default"``. ``tuned``: that
-    tuned range read before (:func:`load_tuned_range`; one of another planner is ignored)."""
+    (an explicit argument), else the tuned range of ``ompl:NAME`` for problems of ``shape``
+    (:meth:`TunedRange.range_for`), else ``DEFAULT_RANGE_DEG``. ``source`` is ``"label"``,
+    ``"argument"``, ``"tuned"`` (``"tuned for 2 arms, 6 joints"`` when another shape's file
+    set it) or ``"default"``. ``tuned``: that tuned range read before
+    (:func:`load_tuned_range`; one of another planner is ignored)."""
     if spec.range_deg is not None:
         return spec.range_deg, "label"
     if step_deg is not None:
@@ -323,7 +353,7 @@ def resolve_range(spec: OmplLabel, step_deg: float | None = None,
         return float(step_deg), "argument"
     if tuned is None or tuned.base != spec.base:
         tuned = load_tuned_range(spec.base)
-    return tuned.range_deg, tuned.source
+    return tuned.range_for(shape)
 
 
 def ompl_seed(seed: int) -> int:
@@ -642,7 +672,8 @@ def plan_ompl(scenario: Scenario, planner: str, seed: int = 0, max_iter: int = 1
             raise InputError("validity_resolution", "sets OMPL's sampled motion check: use "
                              f"{spec.base}:{SAMPLED_OPTION}")
     has_range = hasattr(getattr(og, bare), "setRange")
-    range_deg, range_source = resolve_range(spec, step_deg, tuned) if has_range else (None, None)
+    range_deg, range_source = (resolve_range(spec, step_deg, tuned, shape_of(scenario))
+                               if has_range else (None, None))
     # built once per scenario object, as for our planners (read only here)
     a = scenario_arrays(scenario)
     dof = a.links.shape[0]

@@ -8,11 +8,23 @@ that made it. This module only reads those files, so planning never depends on t
 
 File names: the planner label with ``:`` turned into ``-`` (``rrt`` -> ``rrt.toml``,
 ``ompl:RRTConnect`` -> ``ompl-RRTConnect.toml``).
+
+**Per arm shape.** A peer's best settings depend on the problem's shape: RRT's best step on one
+2-joint arm is not its best on a 7-joint arm or two 3-joint arms (thirty-first session, on
+training problems: the 2-joint settings needed 1.6-2.7x the work of the best ones at 3-7 joints
+and with two arms). Our default is trained on every shape it plans, so a peer tuned on 2-joint
+problems only is a handicapped peer there. A shape is ``(arms, joints)``, the number of arms and
+of joints of all arms together; ``xfuzzy-rrt tune --dof D --arms A`` tunes one and writes its
+own file, named with a suffix (``rrt.2-arms-6-joints.toml``; one 2-joint arm keeps the plain
+``rrt.toml``). A problem whose shape has no file takes the nearest shape that has one
+(:func:`nearest_shape`: the same number of arms and the closest number of joints, fewer on a
+tie; else the closest number of joints), and a result says which shape's settings it ran with.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import stat
 import tomllib
 from functools import lru_cache
@@ -28,26 +40,116 @@ def tuned_dir() -> Path:
     return Path(__file__).resolve().parent.parent / "data" / "tuned"
 
 
-def tuned_file_name(label: str) -> str:
-    """``rrt`` -> ``rrt.toml``; ``ompl:RRTConnect`` -> ``ompl-RRTConnect.toml``."""
-    return label.replace(":", "-") + ".toml"
+#: ``(arms, joints)``: how many arms a problem has and how many joints all of them have together.
+Shape = tuple[int, int]
+#: One 2-joint arm: the shape whose file has no suffix (``rrt.toml``).
+TWO_JOINT: Shape = (1, 2)
 
 
-def tuned_path(label: str) -> Path:
-    return tuned_dir() / tuned_file_name(label)
+def shape_of(scenario) -> Shape:
+    """``(arms, joints)`` of a scenario (joints: of all arms together)."""
+    return (1 + len(scenario.more_arms), int(scenario.dof))
 
 
-def tuned_params(label: str) -> dict[str, float] | None:
-    """The tuned parameters of planner ``label`` (e.g. ``{"step_deg": 60.0, "goal_bias":
-    0.1}`` for ``rrt``, ``{"range_deg": ...}`` for ``ompl:RRTConnect``), or ``None`` when no
-    tuned file ships for it. A file that exists but cannot be read is an :class:`InputError`
-    naming it (a broken shipped file must not silently fall back to untuned settings)."""
-    record = tuned_record(label)
+def shape_text(shape: Shape) -> str:
+    """``(2, 6)`` -> ``"2 arms, 6 joints"``; ``(1, 2)`` -> ``"1 arm, 2 joints"``."""
+    arms, joints = shape
+    return f"{arms} arm{'s' if arms != 1 else ''}, {joints} joints"
+
+
+def shape_suffix(shape: Shape) -> str:
+    """``""`` for one 2-joint arm, else ``".2-arms-6-joints"`` (the part of a file name after
+    the label)."""
+    if tuple(shape) == TWO_JOINT:
+        return ""
+    arms, joints = shape
+    return f".{arms}-arm{'s' if arms != 1 else ''}-{joints}-joints"
+
+
+def tuned_file_name(label: str, shape: Shape = TWO_JOINT) -> str:
+    """``rrt`` -> ``rrt.toml``; ``ompl:RRTConnect`` -> ``ompl-RRTConnect.toml``; with a shape
+    other than one 2-joint arm, ``rrt.1-arm-5-joints.toml``."""
+    return label.replace(":", "-") + shape_suffix(shape) + ".toml"
+
+
+def tuned_path(label: str, shape: Shape = TWO_JOINT) -> Path:
+    return tuned_dir() / tuned_file_name(label, shape)
+
+
+_SHAPE_NAME = re.compile(r"^\.(\d+)-arms?-(\d+)-joints$")
+
+
+def tuned_shapes(label: str) -> tuple[Shape, ...]:
+    """The shapes that have a tuned file of ``label`` in :func:`tuned_dir`, sorted. The folder
+    is listed again only when it changed (its ``mtime_ns``): ``rrt:tuned`` looks here on every
+    plan that was not given its settings."""
+    folder = tuned_dir()
+    try:
+        st = os.stat(folder)
+    except (FileNotFoundError, NotADirectoryError):
+        return ()
+    return _shapes(str(folder), label.replace(":", "-"), (st.st_mtime_ns, st.st_ino))
+
+
+@lru_cache(maxsize=16)
+def _shapes(folder: str, stem: str, identity: tuple) -> tuple[Shape, ...]:
+    found = set()
+    for name in os.listdir(folder):
+        if not name.startswith(stem) or not name.endswith(".toml"):
+            continue
+        rest = name[len(stem):-len(".toml")]
+        if rest == "":
+            found.add(TWO_JOINT)
+        else:
+            m = _SHAPE_NAME.match(rest)
+            if m and int(m.group(1)) >= 1 and int(m.group(2)) >= 1:
+                found.add((int(m.group(1)), int(m.group(2))))
+    return tuple(sorted(found))
+
+
+def nearest_shape(shape: Shape, available) -> Shape | None:
+    """The shape in ``available`` whose settings a problem of ``shape`` runs with: the shape
+    itself; else, among those with as many arms, the closest number of joints (fewer on a
+    tie); else, among all, the closest number of joints, then the closest number of arms,
+    fewer of each on a tie. ``None`` when nothing is available."""
+    available = tuple(available)
+    if not available:
+        return None
+    arms, joints = shape
+    if (arms, joints) in available:
+        return (arms, joints)
+    same = [s for s in available if s[0] == arms]
+    if same:
+        return min(same, key=lambda s: (abs(s[1] - joints), s[1]))
+    return min(available, key=lambda s: (abs(s[1] - joints), abs(s[0] - arms), s[1], s[0]))
+
+
+def tuned_params(label: str, shape: Shape = TWO_JOINT) -> dict[str, float] | None:
+    """The tuned parameters of planner ``label`` for problems of ``shape`` (e.g.
+    ``{"step_deg": 60.0, "goal_bias": 0.1}`` for ``rrt``, ``{"range_deg": ...}`` for
+    ``ompl:RRTConnect``), from the file of :func:`nearest_shape`, or ``None`` when no tuned file
+    ships for it. A file that exists but cannot be read is an :class:`InputError` naming it (a
+    broken shipped file must not silently fall back to untuned settings)."""
+    record = tuned_record(label, shape)
     return None if record is None else dict(record["params"])
 
 
-def tuned_record(label: str) -> dict | None:
-    """The whole parsed tuned file of ``label`` (params, objective, provenance, table).
+def tuned_by_shape(label: str) -> dict[Shape, dict[str, float]]:
+    """Every shipped shape's tuned parameters of ``label`` (one InputError for a broken file):
+    what a caller that plans many problems reads once and picks from per problem
+    (:func:`nearest_shape`)."""
+    out = {}
+    for shape in tuned_shapes(label):
+        record = tuned_record(label, shape, exact=True)
+        if record is not None:
+            out[shape] = dict(record["params"])
+    return out
+
+
+def tuned_record(label: str, shape: Shape = TWO_JOINT, exact: bool = False) -> dict | None:
+    """The whole parsed tuned file of ``label`` (params, objective, provenance, table) for
+    problems of ``shape``: its own file, else (unless ``exact``) the nearest shape's
+    (:func:`nearest_shape`).
 
     Looked up on every plan of a tuned planner (``rrt:tuned`` twice: when its label is parsed
     and when it plans), so it costs one ``os.stat`` of a remembered path string: the parse is
@@ -55,7 +157,11 @@ def tuned_record(label: str) -> dict | None:
     that restores the mtime still changes the ctime). It was ~30 us of pathlib a call, a fifth
     of ``rrt:tuned``'s whole overhead.
     """
-    path = _path_str(tuned_dir(), label)
+    if not exact and tuple(shape) != TWO_JOINT:
+        shape = nearest_shape(tuple(shape), tuned_shapes(label))
+        if shape is None:
+            return None
+    path = _path_str(tuned_dir(), label, tuple(shape))
     try:
         st = os.stat(path)
     except (FileNotFoundError, NotADirectoryError):
@@ -66,8 +172,8 @@ def tuned_record(label: str) -> dict | None:
 
 
 @lru_cache(maxsize=64)
-def _path_str(folder: Path, label: str) -> str:
-    return str(folder / tuned_file_name(label))
+def _path_str(folder: Path, label: str, shape: Shape = TWO_JOINT) -> str:
+    return str(folder / tuned_file_name(label, shape))
 
 
 @lru_cache(maxsize=16)
@@ -86,3 +192,29 @@ def _read(path: str, identity: tuple) -> dict:
             raise InputError(path, f"[params] {key} must be a number, got {value!r}")
     data["params"] = {k: float(v) for k, v in params.items()}
     return data
+
+
+def tuned_for_shapes(label: str, shapes) -> list[tuple[Shape, dict[str, float]]]:
+    """``[(tuned shape, its parameters), ...]``: the settings problems of ``shapes`` run with,
+    one entry per tuned shape used (sorted; a problem shape without its own file counts under
+    :func:`nearest_shape`'s). Empty when no tuned file ships."""
+    available = tuned_shapes(label)
+    used = sorted({nearest_shape(tuple(s), available) for s in shapes} - {None})
+    return [(s, dict(tuned_record(label, s, exact=True)["params"])) for s in used]
+
+
+def describe_tuned_rrt(shapes, degree: str = " deg") -> str:
+    """``"step 300 deg, goal bias 0.05"`` when problems of ``shapes`` run with one tuned
+    shape's settings, else each tuned shape's: ``"1 arm, 2 joints: step 300 deg, goal bias
+    0.05; 1 arm, 5 joints: step 480 deg, goal bias 0.1"`` (what a report or header names the
+    tuned RRT with)."""
+    def one(p):
+        return (f"step {p.get('step_deg', float('nan')):g}{degree}, goal bias "
+                f"{p.get('goal_bias', float('nan')):g}")
+
+    rows = tuned_for_shapes("rrt", shapes)
+    if not rows:
+        return one({})
+    if len(rows) == 1:
+        return one(rows[0][1])
+    return "; ".join(f"{shape_text(s)}: {one(p)}" for s, p in rows)

@@ -141,8 +141,14 @@ def baseline_description(planner: str, tuned: dict | None = None) -> str:
             from xfuzzy_rrt.planners.tuned import tuned_params
 
             params = tuned_params("rrt") or {}
-        return (f"RRT tuned (step {sig(params.get('step_deg'))}\u00b0, goal bias "
-                f"{sig(params.get('goal_bias'))})")
+
+        def one(p):
+            return f"step {sig(p.get('step_deg'))}\u00b0, goal bias {sig(p.get('goal_bias'))}"
+
+        if "by_shape" in params:  # tuned per arm shape (planners/tuned.py)
+            return "RRT tuned (" + "; ".join(f"{shape}: {one(p)}" for shape, p
+                                             in params["by_shape"].items()) + ")"
+        return f"RRT tuned ({one(params)})"
     if planner == BASELINE:
         from xfuzzy_rrt.planners.params import default
 

@@ -112,6 +112,12 @@ class TrainingProblem:
         return int(self.bundle.start.shape[0])
 
     @property
+    def shape(self) -> tuple[int, int]:
+        """``(arms, joints)``: the shape whose tuned RRT is its work baseline
+        (:mod:`xfuzzy_rrt.planners.tuned`)."""
+        return (int(self.bundle.arm_first.shape[0]) - 1, self.dof)
+
+    @property
     def stop_width(self) -> int:
         """Columns of its trees' stop records (:func:`~xfuzzy_rrt.planners.tree.make_tree`)."""
         from xfuzzy_rrt.geometry.problem import stop_record_width
@@ -466,16 +472,21 @@ def tuned_rrt_baselines(problems: list[TrainingProblem], seeds: np.ndarray, max_
                         fitness: str = "work-cvar") -> tuple[np.ndarray, np.ndarray]:
     """The tuned RRT's median work and median path cost (degrees, over its successful runs;
     NaN when none succeeded) per problem over *seeds*, from one set of runs: the references of
-    ``work-cvar`` and ``work-cost-cvar``."""
+    ``work-cvar`` and ``work-cost-cvar``. Each problem's tuned RRT is the one ``rrt:tuned``
+    plans it with: the settings tuned for its shape, else the nearest shape's
+    (:mod:`xfuzzy_rrt.planners.tuned`)."""
     from xfuzzy_rrt.planners.tuned import tuned_params, tuned_path
 
-    params = tuned_params("rrt")
-    if params is None or not {"step_deg", "goal_bias"} <= set(params):
+    if tuned_params("rrt") is None:
         raise InputError("--fitness", f"{fitness} needs the tuned RRT's step_deg and goal_bias "
                          f"in {tuned_path('rrt')} (make it with 'xfuzzy-rrt tune rrt --out FILE')")
     work = np.empty(len(problems))
     cost = np.full(len(problems), np.nan)
     for s, pr in enumerate(problems):
+        params = tuned_params("rrt", pr.shape)
+        if params is None or not {"step_deg", "goal_bias"} <= set(params):
+            raise InputError("--fitness", f"{fitness} needs the tuned RRT's step_deg and "
+                             f"goal_bias in {tuned_path('rrt', pr.shape)}")
         runs = rrt_runs(pr, seeds, max_iter, params["step_deg"], params["goal_bias"])
         work[s] = float(np.median(runs[:, 2]))
         found = runs[runs[:, 0] != 0, 3]

@@ -481,11 +481,11 @@ def write_trained_rulebook(job: TrainJob, result: TrainResult) -> Path:
                                   f"{BASELINE_RUNS - 1}, step 10 deg, goal bias 0.05)")
         provenance["baseline_iterations"] = [float(b) for b in c.baseline]
     if c.fitness in ("work-cvar", "work-cost-cvar"):
-        from xfuzzy_rrt.planners.tuned import tuned_params
+        from xfuzzy_rrt.planners.tuned import describe_tuned_rrt, shape_of
 
-        tuned = tuned_params("rrt") or {}
-        provenance["baseline"] = (f"rrt:tuned (data/tuned/rrt.toml: step {tuned.get('step_deg')} "
-                                  f"deg, goal bias {tuned.get('goal_bias')}) median work per "
+        shapes = [shape_of(t.scenario) for t in job.scenarios]
+        provenance["baseline"] = (f"rrt:tuned (data/tuned/rrt*.toml: "
+                                  f"{describe_tuned_rrt(shapes, degree=' deg')}) median work per "
                                   f"training scenario (seeds 0..{BASELINE_RUNS - 1})")
         provenance["baseline_work"] = [float(b) for b in c.baseline]
     if c.fitness == "work-cost-cvar":

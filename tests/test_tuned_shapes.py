@@ -1,7 +1,7 @@
 """A peer tuned per arm shape: ``rrt:tuned`` and ``ompl:NAME`` run every problem with the
 settings tuned for its shape, or the nearest shape's (planners/tuned.py, "Per arm shape").
 
-Why: RRT's 2-joint settings needed 1.2-2.6x the work of each shape's best at 3-7 joints and
+Why: RRT's 2-joint settings needed 1.2-4.3x the work of each shape's best at 3-7 joints and
 with two to four arms (thirty-first session, training problems), so a peer tuned on 2-joint
 problems only was a handicapped peer wherever the default plans other arms.
 """

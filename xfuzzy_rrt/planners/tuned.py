@@ -11,7 +11,7 @@ File names: the planner label with ``:`` turned into ``-`` (``rrt`` -> ``rrt.tom
 
 **Per arm shape.** A peer's best settings depend on the problem's shape: RRT's best step on one
 2-joint arm is not its best on a 7-joint arm or two 3-joint arms (thirty-first session, on
-training problems: the 2-joint settings needed 1.2-2.6x the work of the best ones at 3-7 joints
+training problems: the 2-joint settings needed 1.2-4.3x the work of the best ones at 3-7 joints
 and with two to four arms). Our default is trained on every shape it plans, so a peer tuned on 2-joint
 problems only is a handicapped peer there. A shape is ``(arms, joints)``, the number of arms and
 of joints of all arms together; ``xfuzzy-rrt tune --dof D --arms A`` tunes one and writes its

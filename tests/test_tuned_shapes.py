@@ -58,7 +58,8 @@ def test_the_nearest_shape_keeps_the_number_of_arms_then_the_closest_joints_fewe
 
 
 def test_the_tuned_files_of_a_folder_are_listed_by_shape(tuned_folder):
-    (tuned_folder / "rrt.not-a-shape.toml").write_text("")
+    (tuned_folder / "rrt-other.toml").write_text("")  # another label's file
+    (tuned_folder / "rrt.toml.bak").write_text("")
     assert tuned.tuned_shapes("rrt") == ((1, 2), (1, 5), (2, 6))
     assert tuned.tuned_by_shape("rrt")[(1, 5)] == {"step_deg": 480.0, "goal_bias": 0.1}
     assert tuned.tuned_params("rrt", (1, 6)) == {"step_deg": 480.0, "goal_bias": 0.1}
@@ -106,6 +107,35 @@ def test_a_broken_shape_file_is_one_error_naming_it(tuned_folder, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and not out.exists()
     assert len(err) == 1 and "rrt.1-arm-5-joints.toml" in err[0], err
+
+
+@pytest.mark.parametrize("name", ["rrt.not-a-shape.toml", "rrt.1-arms-5-joints.toml",
+                                  "rrt.1-arm-2-joints.toml", "rrt.0-arms-4-joints.toml"])
+def test_a_file_named_like_no_shape_is_one_error_naming_it(tuned_folder, capsys, name):
+    """Passed over in silence, its shape would run the nearest shape's settings while the user
+    believes it runs the file's."""
+    from xfuzzy_rrt.cli.main import main
+
+    _write(tuned_folder, name, 90.0, 0.1)
+    out = tuned_folder / "r.json"
+    code = main(["plan", str(FIVE_JOINT), "--planner", "rrt:tuned", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and not out.exists()
+    assert len(err) == 1 and name in err[0] and "not a tuned file name" in err[0], err
+
+
+def test_a_file_tuned_for_another_shape_than_its_name_is_refused(tuned_folder, capsys):
+    from xfuzzy_rrt.cli.main import main
+
+    (tuned_folder / "rrt.1-arm-5-joints.toml").write_text(
+        "[params]\nstep_deg = 480.0\ngoal_bias = 0.1\n"
+        "[provenance]\narms = 2\njoints_per_arm = 3\n")
+    out = tuned_folder / "r.json"
+    code = main(["plan", str(FIVE_JOINT), "--planner", "rrt:tuned", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and not out.exists()
+    assert len(err) == 1 and "rrt.1-arm-5-joints.toml" in err[0], err
+    assert "tuned for 2 arms, 6 joints" in err[0] and "rrt.2-arms-6-joints.toml" in err[0]
 
 
 def test_the_ompl_range_is_tuned_per_shape(monkeypatch, tmp_path):

@@ -147,18 +147,10 @@ class TunedRRT:
         of ``shape``."""
         if not self.by_shape:
             return self.step_deg, self.goal_bias, None
-        return _settings_for(self.by_shape, shape)
+        from xfuzzy_rrt.planners.tuned import nearest_row
 
-
-@functools.lru_cache(maxsize=64)
-def _settings_for(by_shape: tuple, shape: tuple) -> tuple[float, float, tuple]:
-    """:meth:`TunedRRT.settings_for`, remembered: a timed call of the peer pays one dict
-    look-up, not a search over the shapes."""
-    from xfuzzy_rrt.planners.tuned import nearest_shape
-
-    near = nearest_shape(shape, [row[0] for row in by_shape])
-    row = next(r for r in by_shape if r[0] == near)
-    return row[1], row[2], near
+        near, step_deg, goal_bias = nearest_row(self.by_shape, tuple(shape))
+        return step_deg, goal_bias, near
 
 
 def load_tuned_rrt(where: str = "--planner") -> TunedRRT:

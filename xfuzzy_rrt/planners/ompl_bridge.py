@@ -304,16 +304,10 @@ class TunedRange:
         with source ``"tuned"`` (one 2-joint arm) or ``"tuned for 2 arms, 6 joints"``."""
         if not self.by_shape:
             return self.range_deg, self.source
-        return _range_for(self.by_shape, tuple(shape))
+        from xfuzzy_rrt.planners.tuned import nearest_row, tuned_source
 
-
-@functools.lru_cache(maxsize=64)
-def _range_for(by_shape: tuple, shape: tuple) -> tuple[float, str]:
-    from xfuzzy_rrt.planners.tuned import TWO_JOINT, nearest_shape, shape_text
-
-    near = nearest_shape(shape, [row[0] for row in by_shape])
-    r = next(row[1] for row in by_shape if row[0] == near)
-    return r, "tuned" if near == TWO_JOINT else f"tuned for {shape_text(near)}"
+        near, range_deg = nearest_row(self.by_shape, tuple(shape))
+        return range_deg, tuned_source(near)
 
 
 def _checked_range(base: str, tuned: dict) -> float:

@@ -91,6 +91,23 @@ def tuned_shapes(label: str) -> tuple[Shape, ...]:
     return _shapes(str(folder), label.replace(":", "-"), (st.st_mtime_ns, st.st_ino))
 
 
+@lru_cache(maxsize=128)
+def nearest_row(rows: tuple, shape: Shape) -> tuple:
+    """The row of ``rows`` (``((shape, value, ...), ...)``, a shape first in each) whose shape
+    is :func:`nearest_shape` of ``shape``, remembered: what a peer's settings read once
+    (:class:`~xfuzzy_rrt.planners.api.TunedRRT`,
+    :class:`~xfuzzy_rrt.planners.ompl_bridge.TunedRange`) give a problem, at the cost of one
+    dict look-up when a problem's run is bound."""
+    near = nearest_shape(tuple(shape), [row[0] for row in rows])
+    return next(row for row in rows if row[0] == near)
+
+
+def tuned_source(shape: Shape) -> str:
+    """How a result names the tuned settings it ran with: ``"tuned"`` (one 2-joint arm's,
+    the plain file) or ``"tuned for 2 arms, 6 joints"``."""
+    return "tuned" if tuple(shape) == TWO_JOINT else f"tuned for {shape_text(shape)}"
+
+
 @lru_cache(maxsize=16)
 def _shapes(folder: str, stem: str, identity: tuple) -> tuple[Shape, ...]:
     found = set()
@@ -100,11 +117,23 @@ def _shapes(folder: str, stem: str, identity: tuple) -> tuple[Shape, ...]:
         rest = name[len(stem):-len(".toml")]
         if rest == "":
             found.add(TWO_JOINT)
-        else:
-            m = _SHAPE_NAME.match(rest)
-            if m and int(m.group(1)) >= 1 and int(m.group(2)) >= 1:
-                found.add((int(m.group(1)), int(m.group(2))))
+        elif rest.startswith("."):  # another label's file starts with a letter or "-"
+            found.add(_named_shape(os.path.join(folder, name), stem, rest))
     return tuple(sorted(found))
+
+
+def _named_shape(path: str, stem: str, rest: str) -> Shape:
+    """The shape a tuned file's name (``stem`` + ``rest`` + ``.toml``) gives; a name that looks
+    like a shape's file but is not one is an :class:`InputError` naming the file. Why refuse:
+    a file the planners cannot match to a shape would be passed over in silence, and its shape
+    would run the nearest shape's settings while the user believes it runs the file's."""
+    m = _SHAPE_NAME.match(rest)
+    arms, joints = (int(m.group(1)), int(m.group(2))) if m else (0, 0)
+    if arms < 1 or joints < 1 or shape_suffix((arms, joints)) != rest:
+        raise InputError(path, f"not a tuned file name: expected {stem}.toml (one 2-joint arm) "
+                         f"or {stem}.<A>-arm(s)-<J>-joints.toml (e.g. {stem}.1-arm-5-joints.toml, "
+                         f"{stem}.2-arms-6-joints.toml)")
+    return (arms, joints)
 
 
 def nearest_shape(shape: Shape, available) -> Shape | None:
@@ -168,7 +197,7 @@ def tuned_record(label: str, shape: Shape = TWO_JOINT, exact: bool = False) -> d
         return None
     if not stat.S_ISREG(st.st_mode):
         return None
-    return _read(path, (st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino))
+    return _read(path, (st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino), tuple(shape))
 
 
 @lru_cache(maxsize=64)
@@ -177,8 +206,10 @@ def _path_str(folder: Path, label: str, shape: Shape = TWO_JOINT) -> str:
 
 
 @lru_cache(maxsize=16)
-def _read(path: str, identity: tuple) -> dict:
-    """Parsed and checked (cached per file identity, :func:`tuned_record`)."""
+def _read(path: str, identity: tuple, shape: Shape = TWO_JOINT) -> dict:
+    """Parsed and checked (cached per file identity, :func:`tuned_record`): a file whose
+    ``[provenance]`` says it was tuned for another shape than its name's is refused (a renamed
+    file would run one shape's settings on another)."""
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
@@ -191,6 +222,15 @@ def _read(path: str, identity: tuple) -> dict:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise InputError(path, f"[params] {key} must be a number, got {value!r}")
     data["params"] = {k: float(v) for k, v in params.items()}
+    prov = data.get("provenance")
+    if isinstance(prov, dict) and "arms" in prov and "joints_per_arm" in prov:
+        arms, per_arm = prov["arms"], prov["joints_per_arm"]
+        if not all(isinstance(v, int) and not isinstance(v, bool) for v in (arms, per_arm)):
+            raise InputError(path, "[provenance] arms and joints_per_arm must be integers")
+        if (arms, arms * per_arm) != tuple(shape):
+            raise InputError(path, f"tuned for {shape_text((arms, arms * per_arm))} (its "
+                             f"[provenance]) but named for {shape_text(shape)}: rename it "
+                             f"{tuned_file_name(str(data.get('planner', 'rrt')), (arms, arms * per_arm))}")
     return data
 
 
@@ -208,13 +248,18 @@ def describe_tuned_rrt(shapes, degree: str = " deg") -> str:
     shape's settings, else each tuned shape's: ``"1 arm, 2 joints: step 300 deg, goal bias
     0.05; 1 arm, 5 joints: step 480 deg, goal bias 0.1"`` (what a report or header names the
     tuned RRT with)."""
-    def one(p):
-        return (f"step {p.get('step_deg', float('nan')):g}{degree}, goal bias "
-                f"{p.get('goal_bias', float('nan')):g}")
-
     rows = tuned_for_shapes("rrt", shapes)
     if not rows:
-        return one({})
+        return rrt_settings_text({}, degree)
     if len(rows) == 1:
-        return one(rows[0][1])
-    return "; ".join(f"{shape_text(s)}: {one(p)}" for s, p in rows)
+        return rrt_settings_text(rows[0][1], degree)
+    return "; ".join(f"{shape_text(s)}: {rrt_settings_text(p, degree)}" for s, p in rows)
+
+
+def rrt_settings_text(params: dict, degree: str = " deg", number=None) -> str:
+    """``"step 300 deg, goal bias 0.05"``: RRT's two settings as every header, log and report
+    names them (``number`` formats a value, ``None`` when missing: ``format(value, "g")``
+    and ``nan`` unless given)."""
+    number = number or (lambda v: "nan" if v is None else format(v, "g"))
+    return (f"step {number(params.get('step_deg'))}{degree}, goal bias "
+            f"{number(params.get('goal_bias'))}")

@@ -133,17 +133,16 @@ def baseline_description(planner: str, tuned: dict | None = None) -> str:
 
     ``tuned`` is the benchmark's record of what ``rrt:tuned`` resolved to (``bench.json``
     settings); without it, the shipped tuned file."""
+    from xfuzzy_rrt.planners.tuned import rrt_settings_text, tuned_params
     from xfuzzy_rrt.report.numbers import sig
 
     if planner == TUNED_BASELINE:
         params = (tuned or {}).get(TUNED_BASELINE)
         if params is None:
-            from xfuzzy_rrt.planners.tuned import tuned_params
-
             params = tuned_params("rrt") or {}
 
         def one(p):
-            return f"step {sig(p.get('step_deg'))}\u00b0, goal bias {sig(p.get('goal_bias'))}"
+            return rrt_settings_text(p, "\u00b0", sig)
 
         if "by_shape" in params:  # tuned per arm shape (planners/tuned.py)
             return "RRT tuned (" + "; ".join(f"{shape}: {one(p)}" for shape, p

@@ -12,13 +12,17 @@ File names: the planner label with ``:`` turned into ``-`` (``rrt`` -> ``rrt.tom
 **Per arm shape.** A peer's best settings depend on the problem's shape: RRT's best step on one
 2-joint arm is not its best on a 7-joint arm or two 3-joint arms (thirty-first session, on
 training problems: the 2-joint settings needed 1.2-4.3x the work of the best ones at 3-7 joints
-and with two to four arms). Our default is trained on every shape it plans, so a peer tuned on 2-joint
-problems only is a handicapped peer there. A shape is ``(arms, joints)``, the number of arms and
+and with two to four arms). Our default is trained on every shape it plans, so a peer tuned
+on 2-joint problems only is a handicapped peer there. A shape is ``(arms, joints)``, the number of arms and
 of joints of all arms together; ``xfuzzy-rrt tune --dof D --arms A`` tunes one and writes its
 own file, named with a suffix (``rrt.2-arms-6-joints.toml``; one 2-joint arm keeps the plain
 ``rrt.toml``). A problem whose shape has no file takes the nearest shape that has one
 (:func:`nearest_shape`: the same number of arms and the closest number of joints, fewer on a
 tie; else the closest number of joints), and a result says which shape's settings it ran with.
+RRT and OMPL's RRTConnect ship files for one arm of 2 to 7 joints and two, three and four
+2-joint arms and two 3-joint arms (thirty-first and thirty-second sessions). A file whose name
+looks like no shape, or whose ``[provenance]`` was tuned for another shape than its name's, is
+refused with one error naming it (passed over, its shape would silently run another's settings).
 """
 
 from __future__ import annotations
@@ -227,10 +231,11 @@ def _read(path: str, identity: tuple, shape: Shape = TWO_JOINT) -> dict:
         arms, per_arm = prov["arms"], prov["joints_per_arm"]
         if not all(isinstance(v, int) and not isinstance(v, bool) for v in (arms, per_arm)):
             raise InputError(path, "[provenance] arms and joints_per_arm must be integers")
-        if (arms, arms * per_arm) != tuple(shape):
-            raise InputError(path, f"tuned for {shape_text((arms, arms * per_arm))} (its "
-                             f"[provenance]) but named for {shape_text(shape)}: rename it "
-                             f"{tuned_file_name(str(data.get('planner', 'rrt')), (arms, arms * per_arm))}")
+        tuned_for = (arms, arms * per_arm)
+        if tuned_for != tuple(shape):
+            name = tuned_file_name(str(data.get("planner", "rrt")), tuned_for)
+            raise InputError(path, f"tuned for {shape_text(tuned_for)} (its [provenance]) but "
+                             f"named for {shape_text(shape)}: rename it {name}")
     return data
 
 

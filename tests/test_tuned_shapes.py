@@ -44,6 +44,7 @@ def test_a_shape_names_its_file_and_one_two_joint_arm_keeps_the_plain_name():
     assert tuned.shape_of(load_scenario(DUAL_3)) == (2, 6)
     assert tuned.shape_of(load_scenario(FIVE_JOINT)) == (1, 5)
     assert tuned.shape_of(load_scenario(TWO_JOINT)) == (1, 2)
+    assert tuned.arm_shape(3, 2) == (2, 6) and tuned.arm_shape(5) == (1, 5)
 
 
 def test_the_nearest_shape_keeps_the_number_of_arms_then_the_closest_joints_fewer_on_a_tie():

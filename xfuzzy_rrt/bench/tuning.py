@@ -324,7 +324,7 @@ def _num(x: float) -> str:
 def render_tuned_file(result: TuningResult) -> str:
     """The TOML text of the tuned file: deterministic (no dates, no times, no paths)."""
     from xfuzzy_rrt import __version__
-    from xfuzzy_rrt.planners.tuned import shape_text
+    from xfuzzy_rrt.planners.tuned import arm_shape, shape_text
 
     s = result.settings
     names = list(result.grid)
@@ -358,7 +358,7 @@ def render_tuned_file(result: TuningResult) -> str:
         f"generator_seed = {s['seed']}",
         f"families = [{families}]",
         f"problems_per_family = {s['problems']}",
-        f'shape = "{shape_text((s.get("arms", 1), s.get("arms", 1) * s.get("dof", 2)))}"',
+        f'shape = "{shape_text(arm_shape(s.get("dof", 2), s.get("arms", 1)))}"',
         f"joints_per_arm = {s.get('dof', 2)}",
         f"arms = {s.get('arms', 1)}",
         f'plan_seeds = "0..{s["runs"] - 1}"',

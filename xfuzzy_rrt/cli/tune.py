@@ -70,9 +70,9 @@ def tune(
                f"{seconds(elapsed)}; time is shown for information, the objective is end-to-end work)")
     write_text_atomic(out, render_tuned_file(result))
     typer.echo(f"wrote {out}")
-    from xfuzzy_rrt.planners.tuned import shape_text, tuned_file_name
+    from xfuzzy_rrt.planners.tuned import arm_shape, shape_text, tuned_file_name
 
-    shape = (arms, arms * dof)
+    shape = arm_shape(dof, arms)
     if out.name != tuned_file_name(planner, shape):
         typer.echo(f"note: the planners read the settings for {shape_text(shape)} from "
                    f"{tuned_file_name(planner, shape)} in xfuzzy_rrt/data/tuned/")

@@ -17,7 +17,7 @@ from xfuzzy_rrt.planners import setup_memo as _setup_memo
 from xfuzzy_rrt.planners.result import PlanResult, replace_result
 from xfuzzy_rrt.planners.rng import check_seed
 from xfuzzy_rrt.planners.rrt import plan_rrt, plan_rrt_as
-from xfuzzy_rrt.planners.tuned import tuned_path, tuned_record
+from xfuzzy_rrt.planners.tuned import TWO_JOINT, tuned_path, tuned_record
 
 #: The built-in exact planner names (every accepted label form is in planners/registry.py).
 PLANNERS = ("rrt", "fuzzy-rrt", "fuzzy-rrt-connect")
@@ -156,7 +156,7 @@ class TunedRRT:
 def load_tuned_rrt(where: str = "--planner") -> TunedRRT:
     """``rrt:tuned``'s settings as the shipped tuned files give them now, every shape's (one
     InputError naming ``where`` when the 2-joint file is missing or a file is broken)."""
-    from xfuzzy_rrt.planners.tuned import TWO_JOINT, tuned_by_shape
+    from xfuzzy_rrt.planners.tuned import tuned_by_shape
 
     tuned = _tuned_rrt(where)
     rows = []
@@ -406,8 +406,8 @@ def plan_rrt_label(scenario: Scenario, spec: PlannerSpec, rulebook, *, seed, max
                                max_iter=max_iter, clearance_m=clearance_m,
                                max_time_s=max_time_s, step_deg=step, goal_bias=bias)
         shape = shape_of(scenario)
-        near = nearest_shape(shape, tuned_shapes("rrt")) if shape != (1, 2) else shape
-        tuned = _tuned_rrt("--planner", near or (1, 2))
+        near = nearest_shape(shape, tuned_shapes("rrt")) if shape != TWO_JOINT else shape
+        tuned = _tuned_rrt("--planner", near or TWO_JOINT)
         return plan_rrt_as(RRT_TUNED, _tuned_result_params(near), scenario, seed=seed,
                            max_iter=max_iter, clearance_m=clearance_m, max_time_s=max_time_s,
                            **tuned)
@@ -548,7 +548,7 @@ def _ompl_run(scenario_ref, label, max_iter, goal_bias, clearance_m, tuned, seed
                      clearance_m=clearance_m, time_limit_s=None, tuned=tuned)
 
 
-def _tuned_rrt(where: str, shape=(1, 2)) -> dict[str, float]:
+def _tuned_rrt(where: str, shape=TWO_JOINT) -> dict[str, float]:
     """``step_deg`` and ``goal_bias`` of the shipped ``rrt.toml`` (or of ``shape``'s own file,
     :mod:`~xfuzzy_rrt.planners.tuned`), or one InputError.
 

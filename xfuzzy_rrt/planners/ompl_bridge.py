@@ -124,7 +124,7 @@ from xfuzzy_rrt.geometry.problem import Problem
 from xfuzzy_rrt.planners.checks import check_dof, check_max_iter, check_positive
 from xfuzzy_rrt.planners.prepared import scenario_arrays
 from xfuzzy_rrt.planners.result import PlanResult, certified_result, path_cost_deg
-from xfuzzy_rrt.planners.tuned import shape_of
+from xfuzzy_rrt.planners.tuned import TWO_JOINT, shape_of
 from xfuzzy_rrt.planners.tree_arena import pointer_at
 
 OMPL_PREFIX = "ompl:"
@@ -326,14 +326,14 @@ def load_tuned_range(base: str) -> TunedRange:
     rows = tuple(sorted((shape, _checked_range(base, params))
                         for shape, params in tuned_by_shape(base).items()
                         if params.get("range_deg") is not None))
-    two = [r for shape, r in rows if shape == (1, 2)]
+    two = [r for shape, r in rows if shape == TWO_JOINT]
     if rows:
         return TunedRange(base, two[0] if two else rows[0][1], "tuned", rows)
     return TunedRange(base, DEFAULT_RANGE_DEG, "default")
 
 
 def resolve_range(spec: OmplLabel, step_deg: float | None = None,
-                  tuned: TunedRange | None = None, shape=(1, 2)) -> tuple[float, str]:
+                  tuned: TunedRange | None = None, shape=TWO_JOINT) -> tuple[float, str]:
     """``(range_deg, source)`` for a planner that has a range: the label's, else ``step_deg``
     (an explicit argument), else the tuned range of ``ompl:NAME`` for problems of ``shape``
     (:meth:`TunedRange.range_for`), else ``DEFAULT_RANGE_DEG``. ``source`` is ``"label"``,

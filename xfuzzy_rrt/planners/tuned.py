@@ -55,6 +55,12 @@ def shape_of(scenario) -> Shape:
     return (1 + len(scenario.more_arms), int(scenario.dof))
 
 
+def arm_shape(joints_per_arm: int, arms: int = 1) -> Shape:
+    """The shape of ``arms`` arms of ``joints_per_arm`` joints each (what ``tune --dof --arms``
+    and a tuned file's ``[provenance]`` give): ``(arms, arms * joints_per_arm)``."""
+    return (int(arms), int(arms) * int(joints_per_arm))
+
+
 def shape_text(shape: Shape) -> str:
     """``(2, 6)`` -> ``"2 arms, 6 joints"``; ``(1, 2)`` -> ``"1 arm, 2 joints"``."""
     arms, joints = shape
@@ -231,7 +237,7 @@ def _read(path: str, identity: tuple, shape: Shape = TWO_JOINT) -> dict:
         arms, per_arm = prov["arms"], prov["joints_per_arm"]
         if not all(isinstance(v, int) and not isinstance(v, bool) for v in (arms, per_arm)):
             raise InputError(path, "[provenance] arms and joints_per_arm must be integers")
-        tuned_for = (arms, arms * per_arm)
+        tuned_for = arm_shape(per_arm, arms)
         if tuned_for != tuple(shape):
             name = tuned_file_name(str(data.get("planner", "rrt")), tuned_for)
             raise InputError(path, f"tuned for {shape_text(tuned_for)} (its [provenance]) but "

@@ -193,6 +193,53 @@ def test_iterations_count_loop_iterations_not_connect_steps():
     assert r.params["extensions"] >= r.iterations + connected
 
 
+def _grown_runs(s, seeds, max_iter=10_000):
+    return [plan_fuzzy_rrt_connect(s, seed=k, trace=True, max_iter=max_iter) for k in seeds]
+
+
+@pytest.mark.parametrize("path", TWO_JOINTS, ids=lambda p: p.stem)
+def test_every_node_of_both_trees_is_a_root_or_counted_by_one_growth_or_connect(path):
+    s = load_scenario(path)
+    for r in _grown_runs(s, range(4)):
+        t = r.trace
+        assert r.nodes == 2 + int(t["grow_nodes"].sum()) + int(t["connect_nodes"].sum())
+        refused = t["outcome"].isin(["node_in_collision", "edge_blocked"]).to_numpy()
+        # a growth adds nothing exactly when its first (fuzzy-decided) step was refused
+        assert ((t["grow_nodes"].to_numpy() == 0) == (refused | (t["new_node"] < 0))).all()
+        assert not (t["connect_nodes"].to_numpy()[refused] > 0).any()
+
+
+def test_a_growth_goes_on_towards_its_sample_while_its_steps_are_accepted():
+    s = load_scenario(TWO_JOINTS[0])
+    runs = _grown_runs(s, range(10))
+    # rows where the trees did not meet (a join adds the other root's copy as well)
+    multi = [(r, i) for r in runs
+             for i in np.flatnonzero((r.trace["grow_nodes"].to_numpy() > 1)
+                                     & (r.trace["outcome"] == "accepted").to_numpy())]
+    assert multi, "no growth took more than one step in ten runs"
+    for r, i in multi:
+        row = r.trace.iloc[i]
+        first, n = int(row["new_node"]), int(row["grow_nodes"])
+        sample = np.array([row["sample_q1_deg"], row["sample_q2_deg"]])
+        near = r.tree_nodes_deg[int(row["nearest_node"])]
+        # the further steps are a chain from the first, each node the next one's parent ...
+        chain = list(range(first, first + n))
+        assert r.tree_parent[first] == int(row["nearest_node"])
+        assert [int(r.tree_parent[k]) for k in chain[1:]] == chain[:-1]
+        # ... on the line from the nearest node to the sample, by steps of one size
+        span = np.linalg.norm(sample - near)
+        direction = (sample - near) / span
+        along = []
+        for k in chain:
+            off = r.tree_nodes_deg[k] - near
+            assert np.linalg.norm(off - direction * (off @ direction)) < 1e-9
+            along.append(off @ direction)
+        steps = np.diff([0.0, *along])
+        assert np.all(steps > 0) and along[-1] <= span + 1e-9
+        assert steps[:-1] == pytest.approx(np.full(n - 1, steps[0]))
+        assert steps[-1] <= steps[0] + 1e-9  # the last one may stop at the sample
+
+
 def test_explain_reproduces_every_recorded_output_of_a_connect_trace(tmp_path):
     s = load_scenario(TWO_JOINTS[1])
     # a seed whose plan takes several iterations (a lucky one connects at iteration 1)

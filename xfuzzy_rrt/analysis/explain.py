@@ -194,7 +194,7 @@ def explain_row(row: pd.Series, rulebook) -> Explanation:
         *(c for j in js for c in (f"box_q{j}_lo", f"box_q{j}_hi")),
         "step_used_deg", "goal_sampled", *(f"sample_q{j}_deg" for j in js),
         "nearest_node", *(f"new_q{j}_deg" for j in js), "outcome", "new_node", "tree_size",
-        "on_path", "tree", "connect_nodes")
+        "on_path", "tree", "grow_nodes", "connect_nodes")
         if k in row}
     return Explanation(iteration=int(row["iteration"]), rulebook=rulebook.name,
                        bounds_mode=rulebook.bounds_mode, inputs=x, clamped_inputs=clamped,
@@ -286,9 +286,12 @@ def render_text(e: Explanation) -> str:
         if "outcome" in d:
             lines.append(f"  outcome: {d['outcome']}; tree size {int(d['tree_size'])}; "
                          f"on final path: {bool(d.get('on_path'))}")
+        if "grow_nodes" in d:
+            lines.append(f"  growth: the growing tree added {int(d['grow_nodes'])} node(s) "
+                         f"towards the sample (this step and the steps after it)")
         if "connect_nodes" in d:
             lines.append(f"  connect: the other tree added {int(d['connect_nodes'])} node(s) "
-                         f"towards the new configuration")
+                         f"towards the growth's last node")
     lines.append("")
     lines.append(f"max |recomputed - recorded| = {e.max_discrepancy:.3g}")
     return "\n".join(lines) + "\n"

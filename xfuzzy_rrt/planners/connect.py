@@ -39,11 +39,11 @@ iteration: iteration 1 grows the start tree, iteration 2 the goal tree, ...):
    arms (docs/peer-measurements.md, thirty-third session). Only the first step counts for the
    growing tree's ``reject_rate`` (the fuzzy decision it judges); a later step that is
    rejected only ends the run of steps.
-5. **Connect** (only when step 4 added a node): the other tree's node nearest to ``q_new``,
-   the last node step 4 added, extends towards it by certified steps of the same size, each
-   from the node the previous step added, until it reaches ``q_new`` exactly (the trees are
-   joined), a step is rejected, or the tree is full. Every edge of either tree is certified by ``edge_free``
-   with ``P.margin`` and every node by ``config_free``; the junction is one configuration held
+5. **Connect** (only when step 4 added a node): the other tree's node nearest to the last
+   node step 4 added extends towards it by certified steps of the same size, each from the
+   node the previous step added, until it reaches that node exactly (the trees are joined), a
+   step is rejected, or the tree is full. Every edge of either tree is certified by
+   ``edge_free`` with ``P.margin`` and every node by ``config_free``; the junction is one configuration held
    by both trees, so no uncertified edge joins them.
 
 **Rulebooks.** A ``goal-frame`` rulebook (its DOF = the problem's joints in all) or a DOF-free
@@ -60,7 +60,8 @@ junction, reversed; it begins exactly at the start and ends exactly at the goal.
 together), so the growth's further steps and the connect's steps are not iterations: ``nodes``
 (both trees) may exceed ``iterations``. ``params["extensions"]`` counts every extension
 attempted (growth and connect steps). Each tree holds at most ``2 * max_iter + 8`` nodes; a
-growth or a connect stops when its tree is full and a run whose growing tree is full ends as a failure.
+growth or a connect stops when its tree is full, and a run whose growing tree is full ends as a
+failure.
 
 Random draws per iteration: those of goal-frame Fuzzy-RRT's step 3, nothing else, so a seed
 fixes the run byte for byte.

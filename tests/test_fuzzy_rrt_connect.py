@@ -263,6 +263,8 @@ def test_explain_reproduces_every_recorded_output_of_a_connect_trace(tmp_path):
     assert out.returncode == 0, out.stderr
     assert "Fuzzy-RRT-Connect, goal tree grows" in out.stdout
     assert f"planner recorded {float(r.trace.loc[1, 'step_deg'])!r}" in out.stdout
+    grew = int(r.trace.loc[1, "grow_nodes"])
+    assert f"growth: the growing tree added {grew} node(s) towards the sample" in out.stdout
     replay = subprocess.run([*cli, "explain", str(tmp_path / "r.json"), "--iteration", "1"],
                             capture_output=True, text=True)
     assert replay.returncode == 0, replay.stderr

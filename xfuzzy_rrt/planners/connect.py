@@ -149,6 +149,31 @@ def reversed_problem(P):
                    P.start, P.margin, P.clearance, P.work)
 
 
+@nb.njit(cache=True, nogil=True, _nrt=False)
+def _steps_towards(P, T, node, target, step, cap, q_near, q_new):
+    """Extend ``T`` from ``node`` towards ``target`` by steps of ``step`` (the last one
+    shorter), each from the node the one before added, while they are accepted and the tree
+    has room; return ``(outcome, last node, extensions attempted)``.
+
+    The growth's further steps and the connect are this one loop (RRT-Connect's CONNECT).
+    ``outcome`` is ``ACCEPTED`` when the loop ended at ``target`` or at a full tree (the
+    caller tells them apart by ``last``'s configuration), ``GOAL_REACHED`` when a step joined
+    ``P``'s goal (``last`` is that node), else the refusal (``last`` is the node before it).
+    Compiled once, not inlined: one copy of :func:`extend` serves both call sites (a
+    kernel's code is read from memory on a cold call; benchmarks/cold_misses.py).
+    """
+    n = 0
+    while T.meta[0] + 2 <= cap and not _same(T.nodes[node], target):
+        outcome, k = extend(P, T, node, target, step, q_near, q_new)
+        n += 1
+        if outcome == GOAL_REACHED:
+            return outcome, k, n
+        if outcome != ACCEPTED:
+            return outcome, node, n
+        node = k
+    return ACCEPTED, node, n
+
+
 @nb.njit(cache=True, nogil=True, _nrt=True)
 def connect_kernel(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, stop, TR, grown,
                    added, counts):
@@ -280,17 +305,10 @@ def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, sto
         stagnation += 1.0
         last = k
         if outcome == ACCEPTED:
-            while G.meta[0] + 2 <= cap and not _same(G.nodes[last], sample):
-                og, kg = extend(PG, G, last, sample, step, c_near, c_new)
-                extensions += 1
-                if og == GOAL_REACHED:
-                    outcome = GOAL_REACHED
-                    last = kg
-                    break
-                if og != ACCEPTED:
-                    break
-                last = kg
-        reach = G.nodes[last]
+            og, last, n_ext = _steps_towards(PG, G, k, sample, step, cap, c_near, c_new)
+            extensions += n_ext
+            if og == GOAL_REACHED:
+                outcome = GOAL_REACHED
         meet_g = -1
         meet_o = -1
         n_o = O.meta[0]
@@ -299,25 +317,16 @@ def _connect_loop(P, TA, TB, seed, max_iter, knots, consts, scale, min_step, sto
             meet_o = 0
         elif outcome == ACCEPTED:
             # 5. connect the other tree to the growth's last node
-            on = nearest(O, reach)
-            if _same(O.nodes[on], reach):
+            reach = G.nodes[last]
+            oc, ko, n_ext = _steps_towards(PO, O, nearest(O, reach), reach, step, cap, c_near,
+                                           c_new)
+            extensions += n_ext
+            if oc == GOAL_REACHED:  # it joined the growing tree's root
+                meet_g = 0
+                meet_o = ko
+            elif oc == ACCEPTED and _same(O.nodes[ko], reach):
                 meet_g = last
-                meet_o = on
-            else:
-                while O.meta[0] + 2 <= cap:
-                    oc, ko = extend(PO, O, on, reach, step, c_near, c_new)
-                    extensions += 1
-                    if oc == GOAL_REACHED:  # it joined the growing tree's root
-                        meet_g = 0
-                        meet_o = ko
-                        break
-                    if oc != ACCEPTED:
-                        break
-                    on = ko
-                    if _same(c_new, reach):
-                        meet_g = last
-                        meet_o = ko
-                        break
+                meet_o = ko
         gap = _joint_dist(G.nodes[G.meta[0] - 1], O.nodes[O.meta[0] - 1])
         if gap < best:
             best = gap

@@ -19,8 +19,10 @@ arms; docs/peer-measurements.md, thirty-fifth session).
    tree's node nearest to the growing tree: (a) after a CONNECT attempt the two newest nodes
    are the closest pair the last attempt produced -- the place where the trees nearly met, the
    gap to close; (b) it costs no nearest-neighbour query (queries dominate the time of large
-   trees); (c) it moves every iteration, so a tree stuck behind an obstacle sees its target
-   move along the other tree's frontier instead of staring at one fixed point.
+   trees); (c) it moves whenever the other tree grows or a connect adds to it, so a tree
+   stuck behind an obstacle sees its target move along the other tree's frontier instead of
+   staring at one fixed point. (A smaller tree whose growth is refused keeps the iterations,
+   and its target stays where it is until a connect adds to the other tree.)
 2. **Inputs** of the goal-frame semantics (:mod:`xfuzzy_rrt.planners.goal_frame`), read
    relative to the target instead of the goal, at the growing tree's current node ``q`` (the
    node nearest to that tree's previous sample, its root at first -- the paper's carried
